@@ -1,0 +1,110 @@
+//! The interface every scattering model of the project implements.
+//!
+//! Modelled on pbrt-v4's `BxDF` (`f`, `Sample_f`, `PDF`, `Flags`) in the
+//! conventions of DESIGN.md section 2: directions are unit vectors in the local
+//! frame whose `+z` is the macro normal of the front face; `wi` points toward the
+//! light, `wo` toward the viewer; `eval` is the BSDF *without* the cosine factor,
+//! for radiance transport. `sample` is given `wo` and draws `wi`, as a path tracer
+//! does; `pdf(wi, wo)` is the solid-angle density of that draw.
+
+use crate::spectrum::Rgb;
+use glam::DVec3;
+
+/// Which lobes a BSDF (or one sampled event) has, as bits (pbrt-v4's `BxDFFlags`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct BsdfFlags(pub u8);
+
+impl BsdfFlags {
+    /// No lobe (an absorbing or empty BSDF).
+    pub const NONE: BsdfFlags = BsdfFlags(0);
+    /// Scatters back into the hemisphere of `wo`.
+    pub const REFLECTION: BsdfFlags = BsdfFlags(1);
+    /// Scatters into the opposite hemisphere.
+    pub const TRANSMISSION: BsdfFlags = BsdfFlags(2);
+    /// A broad lobe (Lambertian-like).
+    pub const DIFFUSE: BsdfFlags = BsdfFlags(4);
+    /// A glossy lobe (rough microfacet).
+    pub const GLOSSY: BsdfFlags = BsdfFlags(8);
+    /// A Dirac delta lobe (smooth interface, unscattered light through a smooth slab).
+    pub const SPECULAR: BsdfFlags = BsdfFlags(16);
+
+    /// Whether every bit of `o` is set in `self`.
+    pub fn contains(self, o: BsdfFlags) -> bool {
+        self.0 & o.0 == o.0
+    }
+    /// Whether any bit of `o` is set in `self`.
+    pub fn intersects(self, o: BsdfFlags) -> bool {
+        self.0 & o.0 != 0
+    }
+    /// Whether the flags include a delta lobe.
+    pub fn is_specular(self) -> bool {
+        self.intersects(Self::SPECULAR)
+    }
+    /// Whether the flags include a non-delta lobe that `eval` can see.
+    pub fn is_non_specular(self) -> bool {
+        self.intersects(BsdfFlags(Self::DIFFUSE.0 | Self::GLOSSY.0))
+    }
+}
+
+impl std::ops::BitOr for BsdfFlags {
+    type Output = BsdfFlags;
+    fn bitor(self, o: BsdfFlags) -> BsdfFlags {
+        BsdfFlags(self.0 | o.0)
+    }
+}
+impl std::ops::BitOrAssign for BsdfFlags {
+    fn bitor_assign(&mut self, o: BsdfFlags) {
+        self.0 |= o.0;
+    }
+}
+
+/// Whether a quantity is transported from the light (importance, particle
+/// tracing) or gathered from the camera (radiance). They differ by `eta^2`
+/// across a refracting interface (Veach 1997, section 5.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransportMode {
+    /// Radiance, as a path tracer from the camera gathers it.
+    Radiance,
+    /// Importance (flux), as a light tracer or a Monte Carlo photon walk carries it.
+    Importance,
+}
+
+/// One draw of [`Bsdf::sample`].
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    /// The sampled direction toward the light (unit, local frame).
+    pub wi: DVec3,
+    /// The BSDF value `f(wi, wo)` without cosine. For a delta lobe it is the
+    /// lobe's weight divided by `|cos wi|` so that `f |cos| / pdf` is the throughput.
+    pub f: Rgb,
+    /// Solid-angle density of `wi`. For a delta lobe, the discrete probability
+    /// of choosing that lobe.
+    pub pdf: f64,
+    /// The lobe that was sampled (one of REFLECTION/TRANSMISSION with one of DIFFUSE/GLOSSY/SPECULAR).
+    pub flags: BsdfFlags,
+}
+
+impl BsdfSample {
+    /// `f |cos wi| / pdf`: the factor a path's throughput is multiplied by.
+    pub fn weight(&self) -> Rgb {
+        if self.pdf > 0.0 {
+            self.f * (self.wi.z.abs() / self.pdf)
+        } else {
+            Rgb::ZERO
+        }
+    }
+}
+
+/// A BSDF in the local frame, radiance transport (see the module doc).
+pub trait Bsdf: Send + Sync {
+    /// `f(wi, wo)`, without cosine; delta lobes are not included (they are zero
+    /// for any pair of directions `eval` can be given).
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb;
+    /// Draws `wi` for the given `wo` from the random numbers `uc` (lobe choice) and `u`.
+    /// `None` when no direction could be drawn (absorbed, below a grazing limit).
+    fn sample(&self, wo: DVec3, uc: f64, u: [f64; 2]) -> Option<BsdfSample>;
+    /// Solid-angle density with which `sample(wo, ..)` draws `wi`; zero for delta lobes.
+    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64;
+    /// The lobes this BSDF has.
+    fn flags(&self) -> BsdfFlags;
+}

@@ -1,0 +1,90 @@
+//! Small direction helpers in the local frame (`+z` = macro normal of the front face).
+
+use glam::DVec3;
+
+/// `cos theta` of a unit direction.
+#[inline]
+pub fn cos_theta(w: DVec3) -> f64 {
+    w.z
+}
+
+/// `tan^2 theta` of a unit direction (infinite at grazing).
+#[inline]
+pub fn tan2_theta(w: DVec3) -> f64 {
+    let c2 = w.z * w.z;
+    (1.0 - c2).max(0.0) / c2
+}
+
+/// Mirror reflection of `w` about the unit normal `n` (both pointing away from the surface).
+#[inline]
+pub fn reflect(w: DVec3, n: DVec3) -> DVec3 {
+    2.0 * w.dot(n) * n - w
+}
+
+/// Refraction of `w` (pointing away from the surface) through a surface with unit
+/// normal `n`, where `eta_ti` is the index of `w`'s side divided by the index of
+/// the other side (Snell: `sin t = eta_ti sin i`). Returns `None` at total
+/// internal reflection. `n` may face either side.
+#[inline]
+pub fn refract(w: DVec3, n: DVec3, eta_ti: f64) -> Option<DVec3> {
+    let cos_i = w.dot(n);
+    let sin2_t = eta_ti * eta_ti * (1.0 - cos_i * cos_i).max(0.0);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    // The refracted direction lies on the far side of n relative to w.
+    let t = -eta_ti * w + (eta_ti * cos_i - cos_t.copysign(cos_i)) * n;
+    Some(t.normalize())
+}
+
+/// The unit direction with polar angle `theta` (radians, from `+z`) and azimuth `phi`.
+#[inline]
+pub fn spherical_direction(theta: f64, phi: f64) -> DVec3 {
+    let (st, ct) = theta.sin_cos();
+    let (sp, cp) = phi.sin_cos();
+    DVec3::new(st * cp, st * sp, ct)
+}
+
+/// Directions of an in-plane measurement (DESIGN.md section 2): the light at
+/// `theta_i_deg` on the `+x` side above the front face; the viewer at signed
+/// `theta_o_deg` (positive on the light's side), above the sheet for reflection,
+/// below it (measured from `-z`) for transmission. Returns `(wi, wo)`.
+pub fn in_plane_directions(theta_i_deg: f64, theta_o_deg: f64, transmission: bool) -> (DVec3, DVec3) {
+    let ti = theta_i_deg.to_radians();
+    let to = theta_o_deg.to_radians();
+    let wi = DVec3::new(ti.sin(), 0.0, ti.cos());
+    let z = if transmission { -to.cos() } else { to.cos() };
+    let wo = DVec3::new(to.sin(), 0.0, z);
+    (wi, wo)
+}
+
+/// An orthonormal basis `(t, b)` completing the unit vector `n` (Duff et al. 2017).
+#[inline]
+pub fn coordinate_system(n: DVec3) -> (DVec3, DVec3) {
+    let sign = 1.0f64.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (
+        DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        DVec3::new(b, sign + n.y * n.y * a, -n.y),
+    )
+}
+
+/// Cosine-weighted direction on the upper hemisphere (Malley's method).
+#[inline]
+pub fn sample_cosine_hemisphere(u: [f64; 2]) -> DVec3 {
+    let r = u[0].sqrt();
+    let phi = 2.0 * std::f64::consts::PI * u[1];
+    let z = (1.0 - u[0]).max(0.0).sqrt();
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Uniform direction on the unit sphere.
+#[inline]
+pub fn sample_uniform_sphere(u: [f64; 2]) -> DVec3 {
+    let z = 1.0 - 2.0 * u[0];
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * std::f64::consts::PI * u[1];
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+}

@@ -1,0 +1,168 @@
+//! Parameter errors and range checks shared by every model (DESIGN.md section 3).
+//!
+//! A value outside its range is an error that names the parameter, the value
+//! and the allowed range; nothing is clamped silently.
+
+/// An invalid model parameter.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ParamError {
+    /// A number outside its allowed closed range.
+    #[error("parameter `{name}` = {value} is outside its allowed range [{min}, {max}]")]
+    OutOfRange {
+        /// Parameter name as in parameter files.
+        name: String,
+        /// The offending value.
+        value: f64,
+        /// Lower bound (inclusive).
+        min: f64,
+        /// Upper bound (inclusive; may be infinite).
+        max: f64,
+    },
+    /// A number that is NaN or infinite where a finite value is needed.
+    #[error("parameter `{name}` = {value} is not a finite number")]
+    NotFinite {
+        /// Parameter name.
+        name: String,
+        /// The offending value.
+        value: f64,
+    },
+    /// Any other invalid parameter.
+    #[error("parameter `{name}`: {message}")]
+    Invalid {
+        /// Parameter name.
+        name: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+impl ParamError {
+    /// Checks `min <= value <= max` (and that `value` is not NaN; an infinite
+    /// value passes only if `max` is infinite).
+    pub fn check_range(name: &str, value: f64, min: f64, max: f64) -> Result<(), ParamError> {
+        if value.is_nan() || (value.is_infinite() && !(max.is_infinite() && value > 0.0)) {
+            return Err(ParamError::NotFinite { name: name.to_string(), value });
+        }
+        if value < min || value > max {
+            return Err(ParamError::OutOfRange { name: name.to_string(), value, min, max });
+        }
+        Ok(())
+    }
+
+    /// The parameter this error is about.
+    pub fn name(&self) -> &str {
+        match self {
+            ParamError::OutOfRange { name, .. } | ParamError::NotFinite { name, .. } | ParamError::Invalid { name, .. } => name,
+        }
+    }
+}
+
+use crate::microfacet::Distribution;
+
+/// A parameter that may vary with wavelength: a number or an RGB triple
+/// (DESIGN.md section 2). Serialises as a number or a 3-array.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(untagged)]
+pub enum Colour {
+    /// The same value in every channel.
+    Scalar(f64),
+    /// Red, green, blue.
+    Rgb([f64; 3]),
+}
+
+impl Colour {
+    /// The three channels.
+    pub fn rgb(&self) -> crate::Rgb {
+        match *self {
+            Colour::Scalar(v) => crate::Rgb::splat(v),
+            Colour::Rgb(c) => crate::Rgb(c),
+        }
+    }
+    /// Whether it was given as an RGB triple.
+    pub fn is_rgb(&self) -> bool {
+        matches!(self, Colour::Rgb(_))
+    }
+    /// Checks every channel against `[min, max]`; the error names `name` (and the channel).
+    pub fn check_range(&self, name: &str, min: f64, max: f64) -> Result<(), ParamError> {
+        match *self {
+            Colour::Scalar(v) => ParamError::check_range(name, v, min, max),
+            Colour::Rgb(c) => {
+                for (k, v) in c.iter().enumerate() {
+                    ParamError::check_range(&format!("{name}[{k}]"), *v, min, max)?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+/// Parameters of the Paper BSDF (DESIGN.md section 3, supplement Table 2).
+/// Lengths in mm, coefficients in 1/mm.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PaperParams {
+    /// Optional label.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Thickness `d`, mm, in (0, inf).
+    pub d: f64,
+    /// Absorption coefficient `sigma_a`, 1/mm, in [0, inf).
+    pub sigma_a: Colour,
+    /// Scattering coefficient `sigma_s`, 1/mm, in [0, inf).
+    pub sigma_s: Colour,
+    /// Mean cosine of the forward HG lobe, in [-1, 1].
+    pub g_f: f64,
+    /// Mean cosine of the backward HG lobe, in [-1, 1].
+    pub g_b: f64,
+    /// Weight of the backward lobe, in [0, 1].
+    pub w_b: f64,
+    /// Relative index of the front face, in [1, 5].
+    pub eta_f: f64,
+    /// Relative index of the back face, in [1, 5].
+    pub eta_b: f64,
+    /// Roughness (microfacet alpha) of the front face, in [0, pi/2].
+    pub m_f: f64,
+    /// Roughness (microfacet alpha) of the back face, in [0, pi/2].
+    pub m_b: f64,
+    /// Microfacet distribution of the front face.
+    pub dist_f: Distribution,
+    /// Microfacet distribution of the back face.
+    pub dist_b: Distribution,
+}
+
+/// Smallest allowed thickness, mm (the `eps` of Table 2).
+pub const D_MIN: f64 = 1e-6;
+
+impl PaperParams {
+    /// Checks every parameter against DESIGN.md's ranges; the first violation is returned.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        let pi2 = std::f64::consts::FRAC_PI_2;
+        ParamError::check_range("d", self.d, D_MIN, f64::INFINITY)?;
+        if !self.d.is_finite() {
+            return Err(ParamError::NotFinite { name: "d".into(), value: self.d });
+        }
+        self.sigma_a.check_range("sigma_a", 0.0, f64::INFINITY)?;
+        self.sigma_s.check_range("sigma_s", 0.0, f64::INFINITY)?;
+        for (n, v, lo, hi) in [
+            ("g_f", self.g_f, -1.0, 1.0),
+            ("g_b", self.g_b, -1.0, 1.0),
+            ("w_b", self.w_b, 0.0, 1.0),
+            ("eta_f", self.eta_f, 1.0, 5.0),
+            ("eta_b", self.eta_b, 1.0, 5.0),
+            ("m_f", self.m_f, 0.0, pi2),
+            ("m_b", self.m_b, 0.0, pi2),
+        ] {
+            ParamError::check_range(n, v, lo, hi)?;
+        }
+        for (n, c) in [("sigma_a", &self.sigma_a), ("sigma_s", &self.sigma_s)] {
+            if !c.rgb().is_finite() {
+                return Err(ParamError::NotFinite { name: n.into(), value: c.rgb().max_channel() });
+            }
+        }
+        Ok(())
+    }
+    /// Whether any wavelength-dependent parameter is an RGB triple (output has `r,g,b` columns).
+    pub fn is_rgb(&self) -> bool {
+        self.sigma_a.is_rgb() || self.sigma_s.is_rgb()
+    }
+}

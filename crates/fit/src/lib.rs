@@ -1,0 +1,1 @@
+//! paperbsdf-fit (work in progress)

@@ -1,0 +1,1 @@
+//! paperbsdf-io (work in progress)

@@ -1,0 +1,1 @@
+//! paperbsdf-plot (work in progress)

@@ -1,0 +1,1 @@
+//! paperbsdf-render (work in progress)

@@ -1,0 +1,1 @@
+//! paperbsdf-sim (work in progress)
