@@ -14,12 +14,13 @@
 use crate::dielectric::{Interface, RoughDielectric};
 use crate::fresnel::fresnel_dielectric;
 use crate::geometry::{reflect, refract};
+use crate::microfacet::{beckmann_slope_y, Distribution};
 use crate::quadrature::gauss_legendre_01;
 use glam::DVec3;
 
 /// Points per axis of the Gauss-Legendre rule in the visible-normal square used
 /// by [`directional_albedo`].
-pub const DIRECT_QUADRATURE_POINTS: usize = 32;
+pub const DIRECT_QUADRATURE_POINTS: usize = 256;
 
 /// `(reflectance, transmittance)` of the boundary for light arriving from
 /// direction `w` (pointing toward the light, from either side), by quadrature
@@ -43,10 +44,23 @@ pub fn directional_albedo_n(b: &RoughDielectric, w: DVec3, n: usize) -> (f64, f6
     }
     let eta_ti = if w.z > 0.0 { 1.0 / b.eta } else { b.eta };
     let (x, wt) = gauss_legendre_01(n);
+    // Beckmann's visible-normal map is separable: invert once per row and column.
+    let beck = match mf.dist {
+        Distribution::Beckmann => {
+            let fr = mf.beckmann_visible_frame(w);
+            let sx: Vec<f64> = x.iter().map(|&u| fr.slope_x(u)).collect();
+            let sy: Vec<f64> = x.iter().map(|&u| beckmann_slope_y(u)).collect();
+            Some((fr, sx, sy))
+        }
+        Distribution::Ggx => None,
+    };
     let (mut r, mut t) = (0.0, 0.0);
     for (i, &u0) in x.iter().enumerate() {
         for (j, &u1) in x.iter().enumerate() {
-            let h = mf.sample_visible(w, [u0, u1]);
+            let h = match &beck {
+                Some((fr, sx, sy)) => fr.normal(sx[i], sy[j]),
+                None => mf.sample_visible(w, [u0, u1]),
+            };
             let wh = w.dot(h);
             if wh * w.z <= 0.0 {
                 continue;
@@ -70,14 +84,103 @@ pub fn directional_albedo_n(b: &RoughDielectric, w: DVec3, n: usize) -> (f64, f6
 }
 
 /// Number of nodes of the per-surface 1D tables in `mu`.
-pub const N_MU: usize = 33;
+pub const N_MU: usize = 49;
 
-/// `mu` of node `k` of the outside tables: `mu = t^2`, `t` uniform in [0, 1]
-/// (dense near grazing, where a rough face's `Att` changes fastest).
+/// Nodes per segment of the inside grid (three segments).
+const SEG: usize = (N_MU - 1) / 3;
+
+/// Roughness below which the grids no longer narrow with m: there the curves
+/// are dominated by the m-independent Fresnel shape, which misaligned grids
+/// would blur.
+const M_ALIGN: f64 = 0.05;
+
+/// Smallest clustering scale of the grids (in `mu`).
+const W_MIN: f64 = 1e-4;
+
+/// Node placement of one surface's `mu` tables. The sharp features of the
+/// curves have a width proportional to the roughness: the masking fall-off at
+/// grazing (`mu ~ m`) and the transition around the critical angle of total
+/// internal reflection (`mu ~ m sin theta_c`). Nodes are spaced geometrically
+/// away from each feature point, starting at a scale proportional to `m`, so
+/// every surface's features fall on the same node indices and interpolation in
+/// (eta, m) at a fixed index follows them.
+///
+/// Outside: `mu = w ((1 + 1/w)^x - 1)`, `x = k / (N_MU - 1)`.
+/// Inside, three segments of `SEG` intervals: grazing to `mu_c / 2`
+/// (clustered at grazing), `mu_c / 2` to `mu_c` (clustered at `mu_c`), `mu_c`
+/// to 1 (clustered at `mu_c`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MuGrid {
+    /// Cosine of the critical angle from inside.
+    pub mu_c: f64,
+    /// Clustering scale at grazing.
+    pub w_graze: f64,
+    /// Clustering scale at the critical angle.
+    pub w_crit: f64,
+}
+
 #[inline]
-pub fn outside_mu(k: usize) -> f64 {
-    let t = k as f64 / (N_MU - 1) as f64;
-    t * t
+fn geo(w: f64, span: f64, x: f64) -> f64 {
+    if span <= 0.0 {
+        return 0.0;
+    }
+    w * ((1.0 + span / w).powf(x) - 1.0)
+}
+
+#[inline]
+fn geo_inv(w: f64, span: f64, d: f64) -> f64 {
+    if span <= 0.0 {
+        return 0.0;
+    }
+    ((1.0 + d.clamp(0.0, span) / w).ln() / (1.0 + span / w).ln()).clamp(0.0, 1.0)
+}
+
+impl MuGrid {
+    /// The grid of a face of relative index `eta` and roughness `m`.
+    pub fn new(eta: f64, m: f64) -> Self {
+        let mu_c = critical_mu(eta);
+        let s_c = (1.0 - mu_c * mu_c).max(0.0).sqrt();
+        let m = m.max(M_ALIGN);
+        MuGrid {
+            mu_c,
+            w_graze: (0.25 * m).max(W_MIN),
+            w_crit: (0.25 * m * s_c).max(W_MIN),
+        }
+    }
+    /// `mu` of node `k` of the outside tables.
+    pub fn outside_mu(&self, k: usize) -> f64 {
+        geo(self.w_graze, 1.0, k as f64 / (N_MU - 1) as f64).min(1.0)
+    }
+    /// Fractional node coordinate of `mu` on the outside grid.
+    #[inline]
+    pub fn outside_coord(&self, mu: f64) -> f64 {
+        geo_inv(self.w_graze, 1.0, mu) * (N_MU - 1) as f64
+    }
+    /// `mu` of node `k` of the inside tables.
+    pub fn inside_mu(&self, k: usize) -> f64 {
+        let half = 0.5 * self.mu_c;
+        let x = (k % SEG) as f64 / SEG as f64;
+        let mu = match k / SEG {
+            0 => geo(self.w_graze, half, x),
+            1 => self.mu_c - geo(self.w_crit, half, 1.0 - x),
+            2 => self.mu_c + geo(self.w_crit, 1.0 - self.mu_c, x),
+            _ => 1.0,
+        };
+        mu.clamp(0.0, 1.0)
+    }
+    /// Fractional node coordinate of `mu` on the inside grid.
+    #[inline]
+    pub fn inside_coord(&self, mu: f64) -> f64 {
+        let half = 0.5 * self.mu_c;
+        let seg = SEG as f64;
+        if mu >= self.mu_c {
+            2.0 * seg + seg * geo_inv(self.w_crit, 1.0 - self.mu_c, mu - self.mu_c)
+        } else if mu >= half {
+            seg + seg * (1.0 - geo_inv(self.w_crit, half, self.mu_c - mu))
+        } else {
+            seg * geo_inv(self.w_graze, half, mu)
+        }
+    }
 }
 
 /// Cosine of the critical angle seen from inside a face of relative index `eta`
@@ -91,41 +194,43 @@ pub fn critical_mu(eta: f64) -> f64 {
     }
 }
 
-/// `mu` of node `k` of the inside tables: half of the nodes below the critical
-/// cosine `mu_c` (uniform), half above it with quadratic spacing from `mu_c`,
-/// so that the kink of total internal reflection lies on a node for every eta.
+/// Cubic Hermite (Catmull-Rom) interpolation of `tab` at fractional node
+/// coordinate `x`, within the segment of nodes `[lo, hi]` that contains it (the
+/// curves are smooth functions of the node coordinate inside a segment; the
+/// segments meet at the kink of total internal reflection, which no
+/// interpolant crosses). Slopes are central differences, second-order
+/// one-sided at the segment's ends.
 #[inline]
-pub fn inside_mu(k: usize, mu_c: f64) -> f64 {
-    let half = (N_MU - 1) / 2;
-    if k <= half {
-        mu_c * k as f64 / half as f64
-    } else {
-        let s = (k - half) as f64 / half as f64;
-        mu_c + (1.0 - mu_c) * s * s
-    }
-}
-
-/// Fractional node coordinate of `mu` on the inside grid (inverse of [`inside_mu`]).
-#[inline]
-fn inside_coord(mu: f64, mu_c: f64) -> f64 {
-    let half = ((N_MU - 1) / 2) as f64;
-    if mu <= mu_c {
-        if mu_c > 0.0 {
-            half * mu / mu_c
+fn cubic_table(tab: &[f64; N_MU], x: f64, lo: usize, hi: usize) -> f64 {
+    let x = x.clamp(lo as f64, hi as f64);
+    let i = ((x as usize).max(lo)).min(hi - 1);
+    let t = x - i as f64;
+    let slope = |k: usize| -> f64 {
+        if hi - lo < 2 {
+            tab[hi] - tab[lo]
+        } else if k == lo {
+            0.5 * (-3.0 * tab[k] + 4.0 * tab[k + 1] - tab[k + 2])
+        } else if k == hi {
+            0.5 * (3.0 * tab[k] - 4.0 * tab[k - 1] + tab[k - 2])
         } else {
-            half
+            0.5 * (tab[k + 1] - tab[k - 1])
         }
-    } else {
-        half + half * ((mu - mu_c) / (1.0 - mu_c)).max(0.0).sqrt()
-    }
+    };
+    let (p0, p1, m0, m1) = (tab[i], tab[i + 1], slope(i), slope(i + 1));
+    let (t2, t3) = (t * t, t * t * t);
+    (2.0 * t3 - 3.0 * t2 + 1.0) * p0 + (t3 - 2.0 * t2 + t) * m0 + (-2.0 * t3 + 3.0 * t2) * p1 + (t3 - t2) * m1
 }
 
 #[inline]
-fn lerp_table(tab: &[f64; N_MU], x: f64) -> f64 {
-    let x = x.clamp(0.0, (N_MU - 1) as f64);
-    let i = (x as usize).min(N_MU - 2);
-    let f = x - i as f64;
-    tab[i] * (1.0 - f) + tab[i + 1] * f
+fn outside_table(tab: &[f64; N_MU], grid: &MuGrid, mu: f64) -> f64 {
+    cubic_table(tab, grid.outside_coord(mu.abs().min(1.0)), 0, N_MU - 1).max(0.0)
+}
+
+#[inline]
+fn inside_table(tab: &[f64; N_MU], grid: &MuGrid, mu: f64) -> f64 {
+    let x = grid.inside_coord(mu.abs().min(1.0));
+    let seg = ((x as usize) / SEG).min(2);
+    cubic_table(tab, x, seg * SEG, (seg + 1) * SEG).max(0.0)
 }
 
 /// The integrals of one boundary that the Paper BSDF needs, tabulated in `mu`.
@@ -140,8 +245,8 @@ pub struct SurfaceIntegrals {
     pub r_in_nodes: [f64; N_MU],
     /// Transmittance from inside at the inside nodes.
     pub t_in_nodes: [f64; N_MU],
-    /// Cosine of the critical angle from inside.
-    pub mu_c: f64,
+    /// Where the nodes are (depends on eta and m).
+    pub grid: MuGrid,
     /// `rho_in`: hemispherical-hemispherical reflectance for diffuse (cosine-weighted) light from inside.
     pub rho_in: f64,
     /// `Tbar_in`: hemispherical transmittance for diffuse light from inside.
@@ -149,45 +254,88 @@ pub struct SurfaceIntegrals {
 }
 
 impl SurfaceIntegrals {
+    /// The integrals of `b` from the precomputed tables (a few microseconds):
+    /// bilinear interpolation in (eta, m) of the tabulated `mu` curves, exact
+    /// Fresnel for a smooth face, the trivial values for an index-matched face.
+    pub fn new(b: &RoughDielectric) -> Self {
+        match b.interface {
+            Interface::IndexMatched => SurfaceIntegrals {
+                att_nodes: [1.0; N_MU],
+                r_out_nodes: [0.0; N_MU],
+                r_in_nodes: [0.0; N_MU],
+                t_in_nodes: [1.0; N_MU],
+                grid: MuGrid::new(1.0, 0.0),
+                rho_in: 0.0,
+                tbar_in: 1.0,
+            },
+            Interface::Smooth => Self::smooth(b.eta),
+            Interface::Rough(_) => crate::boundary_tables::interpolate(b.dist, b.eta, b.m),
+        }
+    }
+
+    /// All values zero, on the given grid.
+    pub(crate) fn zeroed(grid: MuGrid) -> Self {
+        SurfaceIntegrals {
+            att_nodes: [0.0; N_MU],
+            r_out_nodes: [0.0; N_MU],
+            r_in_nodes: [0.0; N_MU],
+            t_in_nodes: [0.0; N_MU],
+            grid,
+            rho_in: 0.0,
+            tbar_in: 0.0,
+        }
+    }
+
+    /// The integrals of a smooth face of index `eta` (exact Fresnel).
+    pub fn smooth(eta: f64) -> Self {
+        let grid = MuGrid::new(eta, 0.0);
+        let mut s = Self::zeroed(grid);
+        for k in 0..N_MU {
+            let f = fresnel_dielectric(grid.outside_mu(k), eta);
+            s.r_out_nodes[k] = f;
+            s.att_nodes[k] = 1.0 - f;
+            let f = fresnel_dielectric(-grid.inside_mu(k), eta);
+            s.r_in_nodes[k] = f;
+            s.t_in_nodes[k] = 1.0 - f;
+        }
+        let b = RoughDielectric::new(crate::Distribution::Ggx, eta, 0.0).expect("eta in range");
+        let (rho, tbar) = hemispherical_inside(&b, 1);
+        s.rho_in = rho;
+        s.tbar_in = tbar;
+        s
+    }
+
     /// `Att(mu)`: directional transmittance for light from outside at cosine `mu` in [0, 1].
     #[inline]
     pub fn att(&self, mu: f64) -> f64 {
-        lerp_table(&self.att_nodes, mu.abs().min(1.0).sqrt() * (N_MU - 1) as f64)
+        outside_table(&self.att_nodes, &self.grid, mu)
     }
     /// Directional reflectance for light from outside at cosine `mu`.
     #[inline]
     pub fn r_out(&self, mu: f64) -> f64 {
-        lerp_table(&self.r_out_nodes, mu.abs().min(1.0).sqrt() * (N_MU - 1) as f64)
+        outside_table(&self.r_out_nodes, &self.grid, mu)
     }
     /// Directional reflectance (TIR included) for light from inside at cosine `mu` (magnitude).
     #[inline]
     pub fn r_in(&self, mu: f64) -> f64 {
-        lerp_table(&self.r_in_nodes, inside_coord(mu.abs().min(1.0), self.mu_c))
+        inside_table(&self.r_in_nodes, &self.grid, mu)
     }
     /// Directional transmittance for light from inside at cosine `mu` (magnitude).
     #[inline]
     pub fn t_in(&self, mu: f64) -> f64 {
-        lerp_table(&self.t_in_nodes, inside_coord(mu.abs().min(1.0), self.mu_c))
+        inside_table(&self.t_in_nodes, &self.grid, mu)
     }
 
     /// Computes every integral of `b` by direct quadrature with `n` points per
     /// axis (slow: milliseconds; the tables' ground truth).
     pub fn direct(b: &RoughDielectric, n: usize) -> Self {
-        let mu_c = critical_mu(b.eta);
-        let mut s = SurfaceIntegrals {
-            att_nodes: [0.0; N_MU],
-            r_out_nodes: [0.0; N_MU],
-            r_in_nodes: [0.0; N_MU],
-            t_in_nodes: [0.0; N_MU],
-            mu_c,
-            rho_in: 0.0,
-            tbar_in: 0.0,
-        };
+        let grid = MuGrid::new(b.eta, b.m);
+        let mut s = Self::zeroed(grid);
         for k in 0..N_MU {
-            let (r, t) = directional_albedo_n(b, dir_at_mu(outside_mu(k), 1.0), n);
+            let (r, t) = directional_albedo_n(b, dir_at_mu(grid.outside_mu(k), 1.0), n);
             s.r_out_nodes[k] = r;
             s.att_nodes[k] = t;
-            let (r, t) = directional_albedo_n(b, dir_at_mu(inside_mu(k, mu_c), -1.0), n);
+            let (r, t) = directional_albedo_n(b, dir_at_mu(grid.inside_mu(k), -1.0), n);
             s.r_in_nodes[k] = r;
             s.t_in_nodes[k] = t;
         }
@@ -198,10 +346,12 @@ impl SurfaceIntegrals {
     }
 }
 
-/// Direction with `|cos theta| = mu` in the x-z plane, on the side `sign` (+1 outside, -1 inside).
+/// Direction with `|cos theta| = mu` in the x-z plane, on the side `sign` (+1
+/// outside, -1 inside). `mu` below 1e-7 is taken as 1e-7: the integrals' limit
+/// at grazing (reflectance does not vanish there; the exact horizon has no side).
 #[inline]
 pub fn dir_at_mu(mu: f64, sign: f64) -> DVec3 {
-    let mu = mu.clamp(0.0, 1.0);
+    let mu = mu.clamp(1e-7, 1.0);
     DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, sign * mu)
 }
 

@@ -108,3 +108,38 @@ pub trait Bsdf: Send + Sync {
     /// The lobes this BSDF has.
     fn flags(&self) -> BsdfFlags;
 }
+
+/// Directional albedo seen from `wo`, split into reflection and transmission:
+/// `int f(wi, wo) |cos wi| dwi` over each hemisphere (pbrt-v4's `rho(wo)`),
+/// delta lobes included, by `n x n` stratified samples of [`Bsdf::sample`]
+/// (lobe choice from a fixed low-discrepancy offset). For a reciprocal BSDF
+/// (any slab with air on both sides) this is also the fraction of the flux
+/// arriving from `wo` that is reflected and transmitted.
+pub fn sampled_albedo(bsdf: &dyn Bsdf, wo: DVec3, n: usize) -> (Rgb, Rgb) {
+    let (mut r, mut t) = (Rgb::ZERO, Rgb::ZERO);
+    let inv = 1.0 / n as f64;
+    let golden = 0.618_033_988_749_894_9;
+    for i in 0..n {
+        for j in 0..n {
+            let k = (i * n + j) as f64;
+            let uc = (0.5 + k * golden).fract();
+            let u = [
+                (i as f64 + 0.5) * inv,
+                (j as f64 + (0.5 + k * 0.754_877_666).fract()) * inv,
+            ];
+            if let Some(s) = bsdf.sample(wo, uc, [u[0], u[1].min(1.0 - 1e-12)]) {
+                let w = s.weight();
+                if !w.is_finite() {
+                    continue;
+                }
+                if s.wi.z * wo.z > 0.0 {
+                    r += w;
+                } else {
+                    t += w;
+                }
+            }
+        }
+    }
+    let norm = inv * inv;
+    (r * norm, t * norm)
+}

@@ -68,7 +68,12 @@ impl RoughDielectric {
         } else {
             Interface::Rough(Microfacet::new(dist, m))
         };
-        Ok(RoughDielectric { eta, m, dist, interface })
+        Ok(RoughDielectric {
+            eta,
+            m,
+            dist,
+            interface,
+        })
     }
 
     /// `eta_rel` = index of the side opposite `w` over the index of `w`'s side.
@@ -239,7 +244,12 @@ impl RoughDielectric {
                     return None;
                 }
                 let val = self.eval_mode(wi, v, mode);
-                Some(BsdfSample { wi, f: Rgb::splat(val), pdf, flags })
+                Some(BsdfSample {
+                    wi,
+                    f: Rgb::splat(val),
+                    pdf,
+                    flags,
+                })
             }
         }
     }
@@ -280,5 +290,28 @@ impl Bsdf for RoughDielectric {
             Interface::Smooth => BsdfFlags::REFLECTION | BsdfFlags::TRANSMISSION | BsdfFlags::SPECULAR,
             Interface::Rough(_) => BsdfFlags::REFLECTION | BsdfFlags::TRANSMISSION | BsdfFlags::GLOSSY,
         }
+    }
+}
+
+/// Parameters of the `rough-dielectric` model as written in a parameter file:
+/// `eta` in [1, 5], `m` in [0, pi/2], `dist` (`"ggx"` or `"beckmann"`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoughDielectricParams {
+    /// Optional label.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Relative index of refraction, interior over exterior.
+    pub eta: f64,
+    /// Roughness (microfacet alpha); 0 is smooth.
+    pub m: f64,
+    /// Microfacet distribution.
+    pub dist: Distribution,
+}
+
+impl RoughDielectricParams {
+    /// The boundary these parameters describe (validating them).
+    pub fn build(&self) -> Result<RoughDielectric, ParamError> {
+        RoughDielectric::new(self.dist, self.eta, self.m)
     }
 }

@@ -13,7 +13,11 @@ pub fn fresnel_dielectric(cos_i: f64, eta: f64) -> f64 {
     if eta == 1.0 {
         return 0.0;
     }
-    let (eta_it, cos_i) = if cos_i >= 0.0 { (eta, cos_i) } else { (1.0 / eta, -cos_i) };
+    let (eta_it, cos_i) = if cos_i >= 0.0 {
+        (eta, cos_i)
+    } else {
+        (1.0 / eta, -cos_i)
+    };
     let cos_i = cos_i.min(1.0);
     let sin2_t = (1.0 - cos_i * cos_i) / (eta_it * eta_it);
     if sin2_t >= 1.0 {

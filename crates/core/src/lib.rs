@@ -11,18 +11,22 @@
 #![warn(missing_docs)]
 
 pub mod boundary;
+pub mod boundary_tables;
 pub mod bsdf;
 pub mod dielectric;
 pub mod fresnel;
 pub mod geometry;
 pub mod microfacet;
+pub mod models;
+pub mod paper;
 pub mod params;
 pub mod phase;
+pub mod presets;
 pub mod quadrature;
 pub mod spectrum;
 
 pub use bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode};
-pub use dielectric::RoughDielectric;
+pub use dielectric::{RoughDielectric, RoughDielectricParams};
 pub use glam::DVec3;
 pub use microfacet::{Distribution, Microfacet};
 pub use params::{Colour, PaperParams, ParamError};

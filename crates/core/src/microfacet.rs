@@ -81,7 +81,13 @@ impl Microfacet {
             }
             Distribution::Beckmann => {
                 let tan2 = (1.0 - c2).max(0.0) / c2;
-                (-tan2 / a2).exp() / (PI * a2 * c2 * c2)
+                let e = (-tan2 / a2).exp();
+                // At extreme grazing both factors underflow: the limit is 0.
+                if e == 0.0 {
+                    0.0
+                } else {
+                    e / (PI * a2 * c2 * c2)
+                }
             }
         }
     }
@@ -192,84 +198,122 @@ impl Microfacet {
     }
 
     fn sample_visible_beckmann(&self, w: DVec3, u: [f64; 2]) -> DVec3 {
-        // Heitz & d'Eon 2014: stretch to alpha = 1, sample the visible slope
-        // along the incidence plane by inverting its CDF, the other slope from
-        // its Gaussian marginal, rotate back and unstretch.
-        let a = self.alpha;
-        let wi = DVec3::new(a * w.x, a * w.y, w.z).normalize();
+        let frame = BeckmannVisibleFrame::new(self.alpha, w);
+        frame.normal(frame.slope_x(u[0]), beckmann_slope_y(u[1]))
+    }
+
+    /// For quadrature over the visible normals of a Beckmann surface seen from
+    /// `w`: the visible-slope map is separable, `h(u0, u1) = normal(slope_x(u0),
+    /// slope_y(u1))`, so a tensor grid needs only one inversion per row and column.
+    pub fn beckmann_visible_frame(&self, w: DVec3) -> BeckmannVisibleFrame {
+        BeckmannVisibleFrame::new(self.alpha, if w.z < 0.0 { -w } else { w })
+    }
+}
+
+/// The stretched frame of Beckmann visible-normal sampling for one direction
+/// (Heitz & d'Eon 2014): slopes are drawn at alpha = 1 in the incidence plane,
+/// then rotated to the direction's azimuth and scaled by alpha.
+#[derive(Clone, Copy, Debug)]
+pub struct BeckmannVisibleFrame {
+    alpha: f64,
+    cos_phi: f64,
+    sin_phi: f64,
+    cot: f64,
+    erf_cot: f64,
+    e_cot: f64,
+    norm: f64,
+}
+
+impl BeckmannVisibleFrame {
+    fn new(alpha: f64, w: DVec3) -> Self {
+        let wi = DVec3::new(alpha * w.x, alpha * w.y, w.z).normalize();
         let sin_t = (1.0 - wi.z * wi.z).max(0.0).sqrt();
         let (cos_phi, sin_phi) = if sin_t > 1e-12 {
             (wi.x / sin_t, wi.y / sin_t)
         } else {
             (1.0, 0.0)
         };
-        let (sx, sy) = beckmann_sample11(wi.z, sin_t, u);
-        // Rotate the slopes to the azimuth of w, unstretch.
-        let x = (cos_phi * sx - sin_phi * sy) * a;
-        let y = (sin_phi * sx + cos_phi * sy) * a;
-        DVec3::new(-x, -y, 1.0).normalize()
+        // Normal incidence is the limit cot -> inf (the Gaussian itself).
+        let cot = if sin_t > 1e-9 { wi.z / sin_t } else { f64::INFINITY };
+        let (erf_cot, e_cot) = if cot.is_finite() {
+            (libm::erf(cot), (-cot * cot).exp())
+        } else {
+            (1.0, 0.0)
+        };
+        let norm = 0.5 * (cot * (1.0 + erf_cot) + e_cot / PI.sqrt());
+        BeckmannVisibleFrame {
+            alpha,
+            cos_phi,
+            sin_phi,
+            cot,
+            erf_cot,
+            e_cot,
+            norm,
+        }
+    }
+
+    /// The visible slope along the incidence plane for the uniform number `u`
+    /// (inverse CDF of the density `(x + cot) exp(-x^2)` on `x > -cot`; the
+    /// micro-normal has x-component `x` before rotation and scaling).
+    pub fn slope_x(&self, u: f64) -> f64 {
+        if !self.cot.is_finite() {
+            return erfinv(2.0 * u - 1.0);
+        }
+        let (cot, erf_cot, e_cot) = (self.cot, self.erf_cot, self.e_cot);
+        let sqrt_pi = PI.sqrt();
+        let target = u * self.norm;
+        let cdf = |x: f64| 0.5 * (cot * (libm::erf(x) + erf_cot) + (e_cot - (-x * x).exp()) / sqrt_pi);
+        let pdf = |x: f64| (x + cot).max(0.0) * (-x * x).exp() / sqrt_pi;
+        // Bracket: below -6 or above 6 the Gaussian leaves less than 1e-15 of the mass.
+        let mut lo = (-cot).max(-6.0);
+        let mut hi = 6.0f64.max(lo + 1.0);
+        // Start from the Gaussian limit (large cot: the weight is nearly constant).
+        let mut x = erfinv(2.0 * u - 1.0).clamp(lo, hi);
+        if !(x > lo && x < hi) {
+            x = 0.5 * (lo + hi);
+        }
+        // Safeguarded Newton.
+        for _ in 0..60 {
+            let f = cdf(x) - target;
+            if f > 0.0 {
+                hi = x;
+            } else {
+                lo = x;
+            }
+            let d = pdf(x);
+            let mut nx = if d > 0.0 { x - f / d } else { 0.5 * (lo + hi) };
+            if !(nx > lo && nx < hi) {
+                nx = 0.5 * (lo + hi);
+            }
+            let done = (nx - x).abs() < 1e-10 * (1.0 + x.abs()) || hi - lo < 1e-12;
+            x = nx;
+            if done {
+                break;
+            }
+        }
+        x
+    }
+
+    /// The micro-normal for visible slopes `x` (along the incidence plane, from
+    /// [`BeckmannVisibleFrame::slope_x`]) and `y` (from [`beckmann_slope_y`]).
+    #[inline]
+    pub fn normal(&self, x: f64, y: f64) -> DVec3 {
+        let a = self.alpha;
+        let nx = (self.cos_phi * x - self.sin_phi * y) * a;
+        let ny = (self.sin_phi * x + self.cos_phi * y) * a;
+        DVec3::new(nx, ny, 1.0).normalize()
     }
 }
 
-/// Visible slopes of the Beckmann distribution with alpha = 1 for a direction in
-/// the x-z plane with cosine `cos_t` and sine `sin_t`: returns (slope_x, slope_y)
-/// in the convention where the micro-normal is `normalize(-sx, -sy, 1)`.
-fn beckmann_sample11(cos_t: f64, sin_t: f64, u: [f64; 2]) -> (f64, f64) {
-    let sqrt_pi = PI.sqrt();
-    let sy = erfinv(2.0 * u[1] - 1.0);
-    if sin_t < 1e-6 {
-        // Normal incidence: the visible slopes are the slopes, a 2D Gaussian.
-        let r = (-(1.0 - u[0]).max(f64::MIN_POSITIVE).ln()).sqrt();
-        let phi = 2.0 * PI * u[1];
-        return (r * phi.cos(), r * phi.sin());
-    }
-    // Slopes x (with micro-normal (-x, .., 1)) are visible from the direction
-    // (sin_t, 0, cos_t) with weight (cos_t + x sin_t)+, i.e. for x > -cot_t.
-    // Marginal density ∝ (x + cot) exp(-x^2) / sqrt(pi) on x > -cot.
-    // CDF(x) = [cot (erf(x) + erf(cot)) + (exp(-cot^2) - exp(-x^2)) / sqrt(pi)] / 2 / norm.
-    let cot = cos_t / sin_t;
-    let erf_cot = libm::erf(cot);
-    let e_cot = (-cot * cot).exp();
-    let norm = 0.5 * (cot * (1.0 + erf_cot) + e_cot / sqrt_pi);
-    let target = u[0] * norm;
-    let cdf = |x: f64| 0.5 * (cot * (libm::erf(x) + erf_cot) + (e_cot - (-x * x).exp()) / sqrt_pi);
-    let pdf = |x: f64| (x + cot).max(0.0) * (-x * x).exp() / sqrt_pi;
-    // Bracket: the CDF is 0 at -cot and reaches `norm` only as x -> inf.
-    let mut lo = -cot;
-    let mut hi = 1.0f64.max(-cot + 1.0);
-    while cdf(hi) < target {
-        hi = 2.0 * hi + 1.0;
-        if hi > 40.0 {
-            break;
-        }
-    }
-    // Safeguarded Newton.
-    let mut x = 0.5 * (lo + hi);
-    for _ in 0..100 {
-        let f = cdf(x) - target;
-        if f > 0.0 {
-            hi = x;
-        } else {
-            lo = x;
-        }
-        let d = pdf(x);
-        let mut nx = if d > 0.0 { x - f / d } else { 0.5 * (lo + hi) };
-        if !(nx > lo && nx < hi) {
-            nx = 0.5 * (lo + hi);
-        }
-        if (nx - x).abs() < 1e-13 * (1.0 + x.abs()) || hi - lo < 1e-14 {
-            x = nx;
-            break;
-        }
-        x = nx;
-    }
-    // The sampled normal for slope x is (-x, 0, 1) rotated; visible from +x
-    // direction means the slope convention here is negated.
-    (-x, sy)
+/// The visible slope across the incidence plane of a Beckmann surface (Gaussian
+/// with variance 1/2 at alpha = 1) for the uniform number `u`.
+#[inline]
+pub fn beckmann_slope_y(u: f64) -> f64 {
+    erfinv(2.0 * u - 1.0)
 }
 
 /// Inverse error function on (-1, 1): Giles' single-precision approximation
-/// refined by two Newton steps on `libm::erf` (double precision).
+/// refined by one Newton step on `libm::erf` (about 1e-13 relative).
 pub fn erfinv(y: f64) -> f64 {
     if y <= -1.0 {
         return f64::NEG_INFINITY;
@@ -305,7 +349,7 @@ pub fn erfinv(y: f64) -> f64 {
         x = p * y;
     }
     let two_over_sqrt_pi = 2.0 / PI.sqrt();
-    for _ in 0..2 {
+    {
         let err = libm::erf(x) - y;
         x -= err / (two_over_sqrt_pi * (-x * x).exp());
     }
@@ -321,9 +365,9 @@ mod tests {
     fn hemi_integral(f: impl Fn(DVec3) -> f64, n: usize) -> f64 {
         let mut s = 0.0;
         for i in 0..n {
-            // cos theta = t^2 concentrates points near the pole where D peaks.
+            // cos theta = 1 - t^2 concentrates points near the pole where D peaks.
             let t = (i as f64 + 0.5) / n as f64;
-            let ct = t * t;
+            let ct = 1.0 - t * t;
             let jac = 2.0 * t / n as f64;
             for j in 0..(2 * n) {
                 let phi = (j as f64 + 0.5) / (2 * n) as f64 * 2.0 * PI;
@@ -376,7 +420,7 @@ mod tests {
     fn erfinv_inverts_erf() {
         for y in [-0.999999, -0.9, -0.3, 0.0, 0.2, 0.75, 0.99999] {
             let x = erfinv(y);
-            assert!((libm::erf(x) - y).abs() < 1e-14, "{y}");
+            assert!((libm::erf(x) - y).abs() < 1e-12, "{y}");
         }
     }
 }

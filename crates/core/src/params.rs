@@ -41,10 +41,18 @@ impl ParamError {
     /// value passes only if `max` is infinite).
     pub fn check_range(name: &str, value: f64, min: f64, max: f64) -> Result<(), ParamError> {
         if value.is_nan() || (value.is_infinite() && !(max.is_infinite() && value > 0.0)) {
-            return Err(ParamError::NotFinite { name: name.to_string(), value });
+            return Err(ParamError::NotFinite {
+                name: name.to_string(),
+                value,
+            });
         }
         if value < min || value > max {
-            return Err(ParamError::OutOfRange { name: name.to_string(), value, min, max });
+            return Err(ParamError::OutOfRange {
+                name: name.to_string(),
+                value,
+                min,
+                max,
+            });
         }
         Ok(())
     }
@@ -52,7 +60,9 @@ impl ParamError {
     /// The parameter this error is about.
     pub fn name(&self) -> &str {
         match self {
-            ParamError::OutOfRange { name, .. } | ParamError::NotFinite { name, .. } | ParamError::Invalid { name, .. } => name,
+            ParamError::OutOfRange { name, .. }
+            | ParamError::NotFinite { name, .. }
+            | ParamError::Invalid { name, .. } => name,
         }
     }
 }
@@ -139,7 +149,10 @@ impl PaperParams {
         let pi2 = std::f64::consts::FRAC_PI_2;
         ParamError::check_range("d", self.d, D_MIN, f64::INFINITY)?;
         if !self.d.is_finite() {
-            return Err(ParamError::NotFinite { name: "d".into(), value: self.d });
+            return Err(ParamError::NotFinite {
+                name: "d".into(),
+                value: self.d,
+            });
         }
         self.sigma_a.check_range("sigma_a", 0.0, f64::INFINITY)?;
         self.sigma_s.check_range("sigma_s", 0.0, f64::INFINITY)?;
@@ -156,7 +169,10 @@ impl PaperParams {
         }
         for (n, c) in [("sigma_a", &self.sigma_a), ("sigma_s", &self.sigma_s)] {
             if !c.rgb().is_finite() {
-                return Err(ParamError::NotFinite { name: n.into(), value: c.rgb().max_channel() });
+                return Err(ParamError::NotFinite {
+                    name: n.into(),
+                    value: c.rgb().max_channel(),
+                });
             }
         }
         Ok(())

@@ -93,7 +93,10 @@ mod tests {
             for u in [0.05, 0.3, 0.6, 0.95] {
                 let c = sample_hg_cos(g, u);
                 let cdf = (1.0 - g * g) / (2.0 * g) * (1.0 / (1.0 + g * g - 2.0 * g * c).sqrt() - 1.0 / (1.0 + g));
-                assert!((cdf - (1.0 - u)).abs() < 1e-9 || (cdf - u).abs() < 1e-9, "g={g} u={u}: {cdf}");
+                assert!(
+                    (cdf - (1.0 - u)).abs() < 1e-9 || (cdf - u).abs() < 1e-9,
+                    "g={g} u={u}: {cdf}"
+                );
             }
         }
     }

@@ -16,8 +16,19 @@ pub fn read_csv(name: &str) -> Vec<std::collections::HashMap<String, String>> {
     let path = reference_dir().join(name);
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
     let mut lines = text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty());
-    let header: Vec<String> = lines.next().expect("header").split(',').map(|s| s.trim().to_string()).collect();
+    let header: Vec<String> = lines
+        .next()
+        .expect("header")
+        .split(',')
+        .map(|s| s.trim().to_string())
+        .collect();
     lines
-        .map(|l| header.iter().cloned().zip(l.split(',').map(|s| s.trim().to_string())).collect())
+        .map(|l| {
+            header
+                .iter()
+                .cloned()
+                .zip(l.split(',').map(|s| s.trim().to_string()))
+                .collect()
+        })
         .collect()
 }

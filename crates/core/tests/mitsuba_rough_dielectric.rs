@@ -35,7 +35,12 @@ fn eval_matches_mitsuba() {
         }
     }
     let frac = tight as f64 / rows.len() as f64;
-    eprintln!("{tight}/{} rows within 1e-4; worst relative error {:.3e}: {}", rows.len(), worst.0, worst.1);
+    eprintln!(
+        "{tight}/{} rows within 1e-4; worst relative error {:.3e}: {}",
+        rows.len(),
+        worst.0,
+        worst.1
+    );
     assert!(frac >= 0.995, "only {frac} of rows within 1e-4");
     assert!(worst.0 <= 0.02, "a row is off by {}: {}", worst.0, worst.1);
 }

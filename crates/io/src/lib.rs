@@ -1,1 +1,18 @@
-//! paperbsdf-io (work in progress)
+//! # paperbsdf-io
+//!
+//! Reading and writing the project's files in the conventions of DESIGN.md:
+//! parameter files (JSON, TOML or inline JSON) with errors that name the file,
+//! line and parameter; CSV files of direction pairs; atomic output (a temp file
+//! renamed into place, so a failed run leaves no half-written result).
+
+#![warn(missing_docs)]
+
+pub mod atomic;
+pub mod dirs;
+pub mod error;
+pub mod models;
+pub mod params;
+
+pub use atomic::write_atomic;
+pub use error::DataError;
+pub use params::{load_params, Loaded};

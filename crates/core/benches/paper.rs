@@ -1,0 +1,44 @@
+//! Speed of the Paper BSDF with RGB parameters: eval, sample, pdf, and the cost
+//! of building it (`PaperBsdf::new`, which runs once per material, per fit
+//! iteration, or per texel). Targets: eval <= 100 ns, sample <= 150 ns.
+//! Run with `cargo bench -p paperbsdf-core --bench paper`.
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use paperbsdf_core::paper::PaperBsdf;
+use paperbsdf_core::presets;
+use paperbsdf_core::{Bsdf, DVec3};
+
+fn bench(c: &mut Criterion) {
+    for name in ["matte", "glossy"] {
+        let p = presets::preset(name).unwrap();
+        let mut p = p;
+        p.sigma_s = paperbsdf_core::Colour::Rgb([450.0, 430.0, 400.0]);
+        p.sigma_a = paperbsdf_core::Colour::Rgb([0.12, 0.10, 0.07]);
+        let b = PaperBsdf::new(&p).unwrap();
+        let wo = DVec3::new(0.3, 0.1, 0.9).normalize();
+        let wi_r = DVec3::new(-0.4, 0.2, 0.8).normalize();
+        let wi_t = DVec3::new(-0.4, 0.2, -0.8).normalize();
+        c.bench_function(&format!("paper/{name}/eval_reflection"), |bn| {
+            bn.iter(|| black_box(&b).eval(black_box(wi_r), black_box(wo)))
+        });
+        c.bench_function(&format!("paper/{name}/eval_transmission"), |bn| {
+            bn.iter(|| black_box(&b).eval(black_box(wi_t), black_box(wo)))
+        });
+        c.bench_function(&format!("paper/{name}/pdf"), |bn| {
+            bn.iter(|| black_box(&b).pdf(black_box(wi_r), black_box(wo)))
+        });
+        let mut k = 0u64;
+        c.bench_function(&format!("paper/{name}/sample"), |bn| {
+            bn.iter(|| {
+                k = k.wrapping_add(0x9E37_79B9_7F4A_7C15);
+                let u0 = (k >> 11) as f64 / (1u64 << 53) as f64;
+                black_box(&b).sample(black_box(wo), u0, [(u0 * 7.31).fract(), (u0 * 13.7).fract()])
+            })
+        });
+        c.bench_function(&format!("paper/{name}/build"), |bn| {
+            bn.iter(|| PaperBsdf::new(black_box(&p)).unwrap())
+        });
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,46 @@
+//! Writes crates/core/data/boundary_tables.bin (see `paperbsdf_core::boundary_tables`).
+//! Run: `cargo run --release -p paperbsdf-core --example gen_boundary_tables`.
+use paperbsdf_core::boundary::SurfaceIntegrals;
+use paperbsdf_core::boundary_tables::*;
+use paperbsdf_core::{Distribution, RoughDielectric};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+fn main() {
+    let dists = [Distribution::Ggx, Distribution::Beckmann];
+    let jobs: Vec<(Distribution, usize, usize)> = dists
+        .iter()
+        .flat_map(|&d| (0..N_ETA).flat_map(move |i| (0..N_M).map(move |j| (d, i, j))))
+        .collect();
+    let out = std::sync::Mutex::new(vec![0f32; TABLE_LEN]);
+    let next = AtomicUsize::new(0);
+    let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(2);
+    std::thread::scope(|sc| {
+        for _ in 0..threads {
+            sc.spawn(|| loop {
+                let k = next.fetch_add(1, Ordering::Relaxed);
+                if k >= jobs.len() {
+                    break;
+                }
+                let (d, i, j) = jobs[k];
+                // eta = 1 nodes: the limit of a rough face as eta -> 1+.
+                let eta = eta_node(i).max(1.0 + 1e-9);
+                let b = RoughDielectric::new(d, eta, m_node(j)).unwrap();
+                let s = SurfaceIntegrals::direct(&b, TABLE_QUADRATURE_POINTS);
+                let v = encode_node(&s);
+                let o = node_offset(d, i, j);
+                out.lock().unwrap()[o..o + NODE_LEN].copy_from_slice(&v);
+                if k % 50 == 0 {
+                    eprintln!("{k}/{}", jobs.len());
+                }
+            });
+        }
+    });
+    let bytes: Vec<u8> = out.into_inner().unwrap().iter().flat_map(|x| x.to_le_bytes()).collect();
+    // PAPERBSDF_TABLE_OUT overrides the output path (to generate beside the table in use).
+    let path = std::env::var("PAPERBSDF_TABLE_OUT")
+        .unwrap_or_else(|_| concat!(env!("CARGO_MANIFEST_DIR"), "/data/boundary_tables.bin").to_string());
+    let tmp = format!("{path}.tmp");
+    std::fs::write(&tmp, bytes).unwrap();
+    std::fs::rename(&tmp, &path).unwrap();
+    eprintln!("wrote {path}");
+}

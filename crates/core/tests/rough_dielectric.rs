@@ -1,0 +1,319 @@
+//! The rough dielectric boundary: sampling (chi-square), energy, reciprocity,
+//! and the boundary tables against direct quadrature.
+
+#[path = "support/chi2.rs"]
+mod chi2;
+
+use paperbsdf_core::boundary::{directional_albedo_n, hemispherical_inside, SurfaceIntegrals};
+use paperbsdf_core::geometry::spherical_direction;
+use paperbsdf_core::{Bsdf, DVec3, Distribution, RoughDielectric, TransportMode};
+use rand::{Rng, SeedableRng};
+
+const DISTS: [Distribution; 2] = [Distribution::Ggx, Distribution::Beckmann];
+
+fn chi2_grid(dist: Distribution, side: f64) {
+    let mut failures = Vec::new();
+    let mut n = 0;
+    for eta in [1.1, 1.5, 2.4, 5.0] {
+        for m in [0.01, 0.05, 0.2, 0.6, 1.5] {
+            let b = RoughDielectric::new(dist, eta, m).unwrap();
+            for theta_deg in [20.0f64, 55.0, 80.0] {
+                let wo = spherical_direction(theta_deg.to_radians(), 0.3);
+                let wo = DVec3::new(wo.x, wo.y, side * wo.z);
+                let name = format!("{dist} eta={eta} m={m} theta_o={theta_deg} side={side}");
+                let r = chi2::chi2_test(
+                    &name,
+                    |u| {
+                        b.sample(wo, u[0], [u[1], u[2]])
+                            .filter(|s| !s.flags.is_specular())
+                            .map(|s| s.wi)
+                    },
+                    |wi| b.pdf(wi, wo),
+                    100_000,
+                    n as u64 + 17,
+                );
+                n += 1;
+                if let Err(e) = r {
+                    failures.push(e);
+                }
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {n} chi-square tests failed:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn chi2_ggx_from_outside() {
+    chi2_grid(Distribution::Ggx, 1.0);
+}
+#[test]
+fn chi2_ggx_from_inside() {
+    chi2_grid(Distribution::Ggx, -1.0);
+}
+#[test]
+fn chi2_beckmann_from_outside() {
+    chi2_grid(Distribution::Beckmann, 1.0);
+}
+#[test]
+fn chi2_beckmann_from_inside() {
+    chi2_grid(Distribution::Beckmann, -1.0);
+}
+
+/// The sampled throughput `f |cos| / pdf` equals eval/pdf (consistency of the three functions).
+#[test]
+fn sample_value_matches_eval_and_pdf() {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(3);
+    for _ in 0..2000 {
+        let dist = DISTS[rng.gen_range(0..2)];
+        let b = RoughDielectric::new(
+            dist,
+            rng.gen_range(1.01..5.0),
+            rng.gen_range(0.01..std::f64::consts::FRAC_PI_2),
+        )
+        .unwrap();
+        let wo = paperbsdf_core::geometry::sample_uniform_sphere([rng.gen(), rng.gen()]);
+        if let Some(s) = b.sample(wo, rng.gen(), [rng.gen(), rng.gen()]) {
+            let f = b.eval(s.wi, wo).0[0];
+            let p = b.pdf(s.wi, wo);
+            assert!((f - s.f.0[0]).abs() <= 1e-9 * f.abs().max(1.0), "{f} {:?}", s);
+            assert!((p - s.pdf).abs() <= 1e-9 * p.max(1.0));
+        }
+    }
+}
+
+/// Energy: no directional albedo above 1 (flux, both sides), grid over eta, m and angle.
+/// Quadrature error of the 128-point rule is below 1e-3 (see the boundary tests), hence 1 + 1e-3.
+#[test]
+fn no_albedo_above_one() {
+    for dist in DISTS {
+        for eta in [1.0, 1.05, 1.5, 3.0, 5.0] {
+            for m in [0.0, 0.01, 0.1, 0.5, 1.0, std::f64::consts::FRAC_PI_2] {
+                let b = RoughDielectric::new(dist, eta, m).unwrap();
+                for th in [0.0f64, 30.0, 60.0, 80.0, 89.0] {
+                    for side in [1.0, -1.0] {
+                        let w = spherical_direction(th.to_radians(), 0.0);
+                        let w = DVec3::new(w.x, w.y, side * w.z);
+                        let (r, t) = directional_albedo_n(&b, w, 64);
+                        assert!(
+                            r >= 0.0 && t >= 0.0 && r + t <= 1.0 + 1e-3,
+                            "{dist} {eta} {m} {th} {side}: {r} + {t}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Reciprocity across an interface of relative index eta:
+/// `f(wi, wo) / n_o^2 = f(wo, wi) / n_i^2` in radiance transport, and the
+/// importance-transport BSDF is the adjoint `f*(wi, wo) = f(wo, wi)`.
+#[test]
+fn generalised_reciprocity() {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(11);
+    let mut checked = 0;
+    for _ in 0..20000 {
+        let dist = DISTS[rng.gen_range(0..2)];
+        let eta = rng.gen_range(1.01..5.0);
+        let b = RoughDielectric::new(dist, eta, rng.gen_range(0.01..std::f64::consts::FRAC_PI_2)).unwrap();
+        let a = paperbsdf_core::geometry::sample_uniform_sphere([rng.gen(), rng.gen()]);
+        let c = paperbsdf_core::geometry::sample_uniform_sphere([rng.gen(), rng.gen()]);
+        let n = |w: DVec3| if w.z > 0.0 { 1.0 } else { eta };
+        let fac = b.eval(a, c).0[0];
+        let fca = b.eval(c, a).0[0];
+        let lhs = fac / (n(c) * n(c));
+        let rhs = fca / (n(a) * n(a));
+        // 1e-6 relative: the half-vector is formed from different sums on the two sides,
+        // and values can be ~1e-9, so rounding shows at the 1e-7 level.
+        assert!(
+            (lhs - rhs).abs() <= 1e-6 * lhs.abs().max(rhs.abs()).max(1e-12),
+            "{lhs} {rhs}"
+        );
+        let imp = b.eval_mode(a, c, TransportMode::Importance);
+        assert!((imp - fca).abs() <= 1e-6 * imp.abs().max(1e-12), "{imp} {fca}");
+        if fac > 0.0 {
+            checked += 1;
+        }
+    }
+    assert!(checked > 1000);
+}
+
+/// The tables behind `SurfaceIntegrals::new` against direct quadrature
+/// (256 points per axis, error of that reference below ~3e-4 as measured by
+/// examples/quadrature_convergence.rs): `Att`, reflectance from inside, `rho_in` within 0.002.
+#[test]
+fn tables_match_direct_quadrature() {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(5);
+    let mut worst = [0.0f64; 5];
+    for k in 0..24 {
+        let dist = DISTS[k % 2];
+        let eta = 1.0 + 4.0 * rng.gen::<f64>().powi(2);
+        let eta = eta.max(1.02);
+        let m = std::f64::consts::FRAC_PI_2 * rng.gen::<f64>().powi(2);
+        let m = m.max(0.005);
+        let b = RoughDielectric::new(dist, eta, m).unwrap();
+        let t = SurfaceIntegrals::new(&b);
+        for _ in 0..3 {
+            let mu: f64 = rng.gen_range(0.02..1.0);
+            let (ro, to) = directional_albedo_n(&b, paperbsdf_core::boundary::dir_at_mu(mu, 1.0), 256);
+            let (ri, ti) = directional_albedo_n(&b, paperbsdf_core::boundary::dir_at_mu(mu, -1.0), 256);
+            for (q, (got, want)) in [(t.att(mu), to), (t.r_out(mu), ro), (t.r_in(mu), ri), (t.t_in(mu), ti)]
+                .into_iter()
+                .enumerate()
+            {
+                let e = (got - want).abs();
+                worst[q] = worst[q].max(e);
+                assert!(
+                    e <= 0.002,
+                    "quantity {q} of {dist} eta={eta} m={m} mu={mu}: table {got} direct {want}"
+                );
+            }
+        }
+        let (rho, _) = hemispherical_inside(&b, 128);
+        worst[4] = worst[4].max((t.rho_in - rho).abs());
+        assert!(
+            (t.rho_in - rho).abs() <= 0.002,
+            "rho_in {dist} eta={eta} m={m}: {} vs {rho}",
+            t.rho_in
+        );
+    }
+    eprintln!(
+        "worst |table - direct|: att {:.1e} r_out {:.1e} r_in {:.1e} t_in {:.1e} rho_in {:.1e}",
+        worst[0], worst[1], worst[2], worst[3], worst[4]
+    );
+}
+
+/// Reciprocity of the hemispherical integrals: `2 int Att(mu) mu dmu = eta^2 Tbar_in`.
+#[test]
+fn diffuse_transmittance_reciprocity() {
+    for dist in DISTS {
+        for (eta, m) in [(1.3, 0.1), (1.5, 0.4), (2.5, 0.8), (4.0, 1.2)] {
+            let b = RoughDielectric::new(dist, eta, m).unwrap();
+            let s = SurfaceIntegrals::new(&b);
+            let (x, w) = paperbsdf_core::quadrature::gauss_legendre_01(24);
+            // mu = t^2 substitution, matching the table's node spacing.
+            let abar: f64 = x
+                .iter()
+                .zip(&w)
+                .map(|(t, wt)| 2.0 * wt * s.att(t * t) * t * t * 2.0 * t)
+                .sum();
+            assert!(
+                (abar - eta * eta * s.tbar_in).abs() < 3e-3,
+                "{dist} {eta} {m}: {abar} vs {}",
+                eta * eta * s.tbar_in
+            );
+        }
+    }
+}
+
+/// Smooth faces: `rho_in` has a closed form check at normal incidence values and
+/// the smooth tables are exact Fresnel.
+#[test]
+fn smooth_face_integrals() {
+    let s = SurfaceIntegrals::smooth(1.5);
+    assert!((s.att(1.0) - 0.96).abs() < 1e-12);
+    // Known value: internal diffuse reflectance of a smooth n = 1.5 interface is 0.5963 (Egan & Hilgeman).
+    assert!((s.rho_in - 0.5963).abs() < 2e-3, "{}", s.rho_in);
+}
+
+#[test]
+fn bad_parameters_are_errors() {
+    assert!(RoughDielectric::new(Distribution::Ggx, 0.9, 0.1).is_err());
+    assert!(RoughDielectric::new(Distribution::Ggx, 5.1, 0.1).is_err());
+    assert!(RoughDielectric::new(Distribution::Ggx, 1.5, -0.1).is_err());
+    assert!(RoughDielectric::new(Distribution::Ggx, 1.5, 1.6).is_err());
+    assert!(RoughDielectric::new(Distribution::Ggx, f64::NAN, 0.1).is_err());
+    let e = RoughDielectric::new(Distribution::Ggx, 1.5, 2.0)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`m`") && e.contains('2') && e.contains("1.57"), "{e}");
+}
+
+/// m = 0: delta reflection and refraction, chosen with probability F and 1 - F
+/// (checked to 5 sigma of the binomial count), Snell's law, and the radiance
+/// weight `(n_viewer / n_light)^2 (1 - F)`-normalised throughput of refraction.
+#[test]
+fn smooth_interface_delta_lobes() {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(21);
+    for eta in [1.33, 1.5, 2.4] {
+        let b = RoughDielectric::new(Distribution::Ggx, eta, 0.0).unwrap();
+        assert!(b.flags().is_specular());
+        for (theta, side) in [(0.3f64, 1.0), (1.2, 1.0), (0.3, -1.0), (0.6, -1.0)] {
+            let wo = DVec3::new(theta.sin(), 0.0, side * theta.cos());
+            let f = paperbsdf_core::fresnel::fresnel_dielectric(wo.z, eta);
+            let n = 20000;
+            let mut refl = 0;
+            for _ in 0..n {
+                let s = b.sample(wo, rng.gen(), [rng.gen(), rng.gen()]).unwrap();
+                assert!(s.flags.is_specular());
+                assert_eq!(b.eval(s.wi, wo).0[0], 0.0);
+                assert_eq!(b.pdf(s.wi, wo), 0.0);
+                if s.wi.z * wo.z > 0.0 {
+                    refl += 1;
+                    assert!((s.wi - DVec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-12);
+                    assert!((s.weight().0[0] - 1.0).abs() < 1e-12);
+                } else {
+                    // Snell: n_o sin_o = n_i sin_i.
+                    let (n_o, n_i) = if wo.z > 0.0 { (1.0, eta) } else { (eta, 1.0) };
+                    let sin = |w: DVec3| (w.x * w.x + w.y * w.y).sqrt();
+                    assert!((n_o * sin(wo) - n_i * sin(s.wi)).abs() < 1e-12);
+                    let want = (n_o / n_i) * (n_o / n_i);
+                    assert!((s.weight().0[0] - want).abs() < 1e-12, "{} vs {want}", s.weight().0[0]);
+                }
+            }
+            let sigma = (n as f64 * f * (1.0 - f)).sqrt().max(1.0);
+            assert!(
+                (refl as f64 - n as f64 * f).abs() < 5.0 * sigma,
+                "eta {eta} theta {theta} side {side}: {refl} vs {}",
+                n as f64 * f
+            );
+        }
+    }
+    // Index-matched: straight through.
+    let b = RoughDielectric::new(Distribution::Beckmann, 1.0, 0.4).unwrap();
+    let wo = DVec3::new(0.6, 0.0, 0.8);
+    let s = b.sample(wo, 0.5, [0.5, 0.5]).unwrap();
+    assert_eq!(s.wi, -wo);
+    assert!((s.weight().0[0] - 1.0).abs() < 1e-12);
+}
+
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn dir(a: f64, b: f64) -> DVec3 {
+        paperbsdf_core::geometry::sample_uniform_sphere([a, b])
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(4000))]
+        /// No NaN, infinity or negative value from eval, pdf or sample, for any
+        /// parameters in range and any directions, grazing and exactly horizontal included.
+        #[test]
+        fn finite_and_non_negative(
+            beck in any::<bool>(), eta in 1.0f64..=5.0, m in 0.0f64..=std::f64::consts::FRAC_PI_2,
+            a in 0.0f64..1.0, b in 0.0f64..1.0, c in 0.0f64..1.0, d in 0.0f64..1.0,
+            graze in 0u8..4, u in proptest::array::uniform3(0.0f64..1.0),
+        ) {
+            let dist = if beck { Distribution::Beckmann } else { Distribution::Ggx };
+            let bs = RoughDielectric::new(dist, eta, m).unwrap();
+            let mut wi = dir(a, b);
+            let mut wo = dir(c, d);
+            if graze & 1 == 1 { wi = DVec3::new(wi.x, wi.y, 0.0).try_normalize().unwrap_or(DVec3::X); }
+            if graze & 2 == 2 { wo = DVec3::new(wo.x, wo.y, 1e-9 * wo.z.signum()).normalize(); }
+            let f = bs.eval(wi, wo).0[0];
+            let p = bs.pdf(wi, wo);
+            prop_assert!(f.is_finite() && f >= 0.0, "f = {}", f);
+            prop_assert!(p.is_finite() && p >= 0.0, "pdf = {}", p);
+            if let Some(s) = bs.sample(wo, u[0], [u[1], u[2]]) {
+                prop_assert!(s.f.is_finite() && s.f.0[0] >= 0.0 && s.pdf.is_finite() && s.pdf > 0.0, "{:?}", s);
+                prop_assert!((s.wi.length() - 1.0).abs() < 1e-9);
+            }
+        }
+    }
+}

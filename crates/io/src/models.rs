@@ -1,0 +1,116 @@
+//! Models by name, built from a parameter source: the registry that the CLI,
+//! the fitter and the renderer share. Names (DESIGN.md 4.7): `paper`,
+//! `reduced-multilayer` (same parameters as `paper`), `lambert-glass`,
+//! `rough-dielectric`.
+
+use crate::params::{parse_text, read_source, Loaded};
+use crate::DataError;
+use paperbsdf_core::models::{ComponentModel, LambertGlass, LambertGlassParams, MODEL_NAMES};
+use paperbsdf_core::paper::{Component, PaperBsdf};
+use paperbsdf_core::{Bsdf, DVec3, PaperParams, ParamError, Rgb, RoughDielectric, RoughDielectricParams};
+
+/// A model loaded from a parameter file.
+pub enum LoadedModel {
+    /// `paper` or `reduced-multilayer`.
+    Paper(Box<PaperBsdf>),
+    /// `lambert-glass`.
+    LambertGlass(Box<LambertGlass>),
+    /// `rough-dielectric`.
+    RoughDielectric(RoughDielectric),
+}
+
+/// Loads model `name` with parameters from `source` (file path or inline JSON).
+pub fn load_model(name: &str, source: &str) -> Result<LoadedModel, DataError> {
+    let (text, origin, is_toml) = read_source(source)?;
+    load_model_text(name, &text, &origin, is_toml)
+}
+
+/// Builds model `name` from the text of a parameter set (JSON, or TOML when
+/// `is_toml`); `origin` names it in errors.
+pub fn load_model_text(name: &str, text: &str, origin: &str, is_toml: bool) -> Result<LoadedModel, DataError> {
+    fn loaded<T: serde::de::DeserializeOwned>(text: &str, origin: &str, is_toml: bool) -> Result<Loaded<T>, DataError> {
+        let value = parse_text(text, origin, is_toml)?;
+        Ok(Loaded {
+            value,
+            origin: origin.to_string(),
+            text: text.to_string(),
+            is_toml,
+        })
+    }
+    fn build<T, U>(l: &Loaded<T>, f: impl FnOnce(&T) -> Result<U, ParamError>) -> Result<U, DataError> {
+        f(&l.value).map_err(|e| l.param_error(e))
+    }
+    Ok(match name {
+        "paper" => LoadedModel::Paper(Box::new(build(
+            &loaded::<PaperParams>(text, origin, is_toml)?,
+            PaperBsdf::new,
+        )?)),
+        "reduced-multilayer" => LoadedModel::Paper(Box::new(build(
+            &loaded::<PaperParams>(text, origin, is_toml)?,
+            PaperBsdf::reduced_multilayer,
+        )?)),
+        "lambert-glass" => LoadedModel::LambertGlass(Box::new(build(
+            &loaded::<LambertGlassParams>(text, origin, is_toml)?,
+            LambertGlass::new,
+        )?)),
+        "rough-dielectric" => {
+            LoadedModel::RoughDielectric(build(&loaded::<RoughDielectricParams>(text, origin, is_toml)?, |p| {
+                p.build()
+            })?)
+        }
+        _ => {
+            return Err(DataError::Other {
+                file: origin.to_string(),
+                message: format!("unknown model `{name}`; known models: {}", MODEL_NAMES.join(", ")),
+            })
+        }
+    })
+}
+
+impl LoadedModel {
+    /// The model, with its components.
+    pub fn model(&self) -> &dyn ComponentModel {
+        match self {
+            LoadedModel::Paper(m) => m.as_ref(),
+            LoadedModel::LambertGlass(m) => m.as_ref(),
+            LoadedModel::RoughDielectric(m) => m,
+        }
+    }
+
+    /// Whether the model's values have three distinct channels (print `r,g,b`).
+    pub fn is_rgb(&self) -> bool {
+        self.model().is_rgb()
+    }
+
+    /// `f(wi, wo)` of one component (`surface`, `single`, `multiple`, `direct`) or `all`.
+    pub fn eval_component(&self, wi: DVec3, wo: DVec3, component: &str) -> Result<Rgb, String> {
+        if component == "all" {
+            return Ok(self.model().eval(wi, wo));
+        }
+        match Component::parse(component) {
+            Some(c) => Ok(self.model().eval_component(wi, wo, c)),
+            None => Err(format!(
+                "unknown component `{component}`: expected surface, single, multiple, direct or all"
+            )),
+        }
+    }
+
+    /// Directional albedo `(reflectance, transmittance)` for light arriving from
+    /// direction `w` (pointing toward the light): flux fractions. The rough
+    /// dielectric uses the converged quadrature of `boundary` (importance
+    /// transport, no eta^2, as Mitsuba's albedo); the slab models, which have air
+    /// on both sides and are reciprocal, use 512 x 512 stratified samples of their
+    /// own sampling routine ([`paperbsdf_core::bsdf::sampled_albedo`]).
+    pub fn albedo(&self, w: DVec3) -> (Rgb, Rgb) {
+        match self {
+            LoadedModel::RoughDielectric(b) => {
+                let (r, t) = paperbsdf_core::boundary::directional_albedo_n(b, w, 256);
+                (Rgb::splat(r), Rgb::splat(t))
+            }
+            _ => {
+                let bsdf: &dyn Bsdf = self.model();
+                paperbsdf_core::bsdf::sampled_albedo(bsdf, w, 512)
+            }
+        }
+    }
+}
