@@ -1,14 +1,358 @@
-//! `paperbsdf simulate` (being built; see the issue tracker).
+//! `paperbsdf simulate`: the ground truth. Monte Carlo simulation of the physical
+//! paper slab (crate `paperbsdf-sim`): in-plane BSDF values with standard errors,
+//! or total reflectance and transmittance, in the conventions of DESIGN.md
+//! section 2 (`f` without cosine; `theta_o` signed, negative on the side
+//! opposite the light; `R` rows seen from `z > 0`, `T` rows from `z < 0`).
+
+use anyhow::{bail, Context, Result};
+use paperbsdf_core::geometry::in_plane_directions;
+use paperbsdf_core::{PaperParams, Rgb};
+use paperbsdf_sim::{simulate_bsdf, simulate_totals, Estimate, Incidence, SimConfig, Slab};
 
 /// Arguments of `paperbsdf simulate`.
 #[derive(clap::Args, Debug)]
 pub struct SimulateArgs {
-    /// Arguments (not yet defined).
-    #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-    pub rest: Vec<String>,
+    /// Paper parameters: a JSON or TOML file, or inline JSON.
+    #[arg(long)]
+    pub params: String,
+    /// In-plane incident angles in degrees, comma-separated, in [0, 90).
+    #[arg(long = "theta-i", value_delimiter = ',')]
+    pub theta_i: Vec<f64>,
+    /// In-plane viewing angles FROM:TO:STEP in degrees, in (-90, 90); both R and T rows are printed.
+    #[arg(long = "theta-o", allow_hyphen_values = true)]
+    pub theta_o: Option<String>,
+    /// Print total reflectance and transmittance per incident angle instead of BSDF values.
+    #[arg(long, conflicts_with = "theta_o")]
+    pub totals: bool,
+    /// With --totals: diffuse (cosine-weighted) incident light on the front face instead of --theta-i.
+    #[arg(long, requires = "totals", conflicts_with = "theta_i")]
+    pub diffuse: bool,
+    /// Random walks per incident angle (and colour channel).
+    #[arg(long, conflicts_with = "rel_stderr")]
+    pub samples: Option<u64>,
+    /// Keep simulating until every positive estimate has a standard error below this fraction of its value.
+    #[arg(long = "rel-stderr")]
+    pub rel_stderr: Option<f64>,
+    /// Upper limit of walks per incident angle with --rel-stderr.
+    #[arg(long = "max-samples", default_value_t = 1 << 26)]
+    pub max_samples: u64,
+    /// Independent batches the walks are split into (standard errors come from their spread).
+    #[arg(long, default_value_t = 32)]
+    pub batches: u32,
+    /// Seed; the output is reproducible for a given seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Write the table to this file (atomically) instead of standard output.
+    #[arg(long)]
+    pub out: Option<String>,
+}
+
+/// Default walks per incident angle when neither --samples nor --rel-stderr is given.
+const DEFAULT_SAMPLES: u64 = 1 << 16;
+/// First round of walks with --rel-stderr.
+const ADAPTIVE_FIRST_ROUND: u64 = 1 << 13;
+
+/// Loads and validates the parameters; errors name the file, line and parameter.
+fn load(source: &str) -> Result<PaperParams> {
+    let l = paperbsdf_io::load_params::<PaperParams>(source)?;
+    if let Err(e) = l.value.validate() {
+        return Err(l.param_error(e).into());
+    }
+    Ok(l.value)
+}
+
+/// Parses `FROM:TO:STEP` (degrees) into the list of angles, TO included when hit.
+fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
+    let parts: Vec<&str> = s.split(':').collect();
+    if parts.len() != 3 {
+        bail!("{what} `{s}`: expected FROM:TO:STEP in degrees, e.g. -80:80:10");
+    }
+    let num = |p: &str| {
+        p.trim()
+            .parse::<f64>()
+            .with_context(|| format!("{what} `{s}`: `{p}` is not a number"))
+    };
+    let (from, to, step) = (num(parts[0])?, num(parts[1])?, num(parts[2])?);
+    if !(step > 0.0 && from.is_finite() && to.is_finite()) {
+        bail!("{what} `{s}`: STEP must be positive and FROM, TO finite");
+    }
+    let n = ((to - from) / step + 1e-9).floor();
+    if n < 0.0 {
+        bail!("{what} `{s}`: TO is below FROM");
+    }
+    if n > 10_000.0 {
+        bail!("{what} `{s}`: more than 10000 angles");
+    }
+    Ok((0..=n as usize).map(|k| from + k as f64 * step).collect())
+}
+
+/// Checks that every angle is finite and within `(lo, hi)` (open) or `[lo, hi)`.
+fn check_angles(v: &[f64], what: &str, lo: f64, lo_inclusive: bool, hi: f64) -> Result<()> {
+    for &a in v {
+        let above = if lo_inclusive { a >= lo } else { a > lo };
+        if !(a.is_finite() && above && a < hi) {
+            let open = if lo_inclusive { '[' } else { '(' };
+            bail!("{what} = {a} is outside the allowed range {open}{lo}, {hi}) degrees");
+        }
+    }
+    Ok(())
+}
+
+fn config(a: &SimulateArgs) -> Result<SimConfig> {
+    if let Some(x) = a.rel_stderr {
+        if !(x > 0.0 && x < 1.0) {
+            bail!("--rel-stderr = {x} is outside the allowed range (0, 1)");
+        }
+    }
+    if a.samples == Some(0) {
+        bail!("--samples = 0: need at least one walk");
+    }
+    if a.batches < 2 {
+        bail!(
+            "--batches = {}: need at least 2 batches for a standard error",
+            a.batches
+        );
+    }
+    let samples = match (a.samples, a.rel_stderr) {
+        (Some(n), _) => n,
+        (None, Some(_)) => ADAPTIVE_FIRST_ROUND,
+        (None, None) => DEFAULT_SAMPLES,
+    };
+    Ok(SimConfig {
+        samples: samples.max(a.batches as u64),
+        batches: a.batches,
+        seed: a.seed,
+        rel_stderr: a.rel_stderr,
+        max_samples: a.max_samples,
+        progress: true,
+        by_order: false,
+    })
+}
+
+fn fmt(v: f64) -> String {
+    format!("{v:.6e}")
+}
+
+/// `f,stderr` for scalar parameters, `r,g,b,r_stderr,g_stderr,b_stderr` for RGB.
+fn fmt_estimate(e: &Estimate, rgb: bool) -> String {
+    if rgb {
+        let c = |x: Rgb| x.0.iter().map(|&v| fmt(v)).collect::<Vec<_>>().join(",");
+        format!("{},{}", c(e.mean), c(e.stderr))
+    } else {
+        format!("{},{}", fmt(e.mean.0[0]), fmt(e.stderr.0[0]))
+    }
+}
+
+fn header_line(p: &PaperParams, cfg: &SimConfig) -> String {
+    let json = serde_json::to_string(p).unwrap_or_default();
+    let mode = match cfg.rel_stderr {
+        Some(x) => format!(
+            "until rel. stderr <= {x} (first round {} walks, max {})",
+            cfg.samples, cfg.max_samples
+        ),
+        None => format!("{} walks per incident angle and channel", cfg.samples),
+    };
+    format!(
+        "# paperbsdf simulate (Monte Carlo ground truth, paperbsdf-sim {}): f without cosine, theta_o < 0 opposite the light; {mode}, {} batches, seed {}; params: {json}\n",
+        env!("CARGO_PKG_VERSION"),
+        cfg.batches,
+        cfg.seed
+    )
 }
 
 /// Runs `paperbsdf simulate`.
-pub fn run(_args: SimulateArgs) -> anyhow::Result<()> {
-    anyhow::bail!("`paperbsdf simulate` is not available in this build yet")
+pub fn run(a: SimulateArgs) -> Result<()> {
+    let p = load(&a.params)?;
+    let slab = Slab::from_params(&p).with_context(|| format!("parameters `{}`", a.params))?;
+    let cfg = config(&a)?;
+    let rgb = slab.rgb;
+    let mut text = header_line(&p, &cfg);
+    if a.totals {
+        let cols = if rgb {
+            "R_r,R_g,R_b,R_r_stderr,R_g_stderr,R_b_stderr,T_r,T_g,T_b,T_r_stderr,T_g_stderr,T_b_stderr"
+        } else {
+            "R,R_stderr,T,T_stderr"
+        };
+        if a.diffuse {
+            text.push_str(&format!("incidence,{cols}\n"));
+            let t = simulate_totals(&slab, Incidence::Diffuse { front: true }, &cfg)?;
+            text.push_str(&format!(
+                "diffuse,{},{}\n",
+                fmt_estimate(&t.reflectance, rgb),
+                fmt_estimate(&t.transmittance, rgb)
+            ));
+        } else {
+            if a.theta_i.is_empty() {
+                bail!("--totals needs --theta-i LIST (degrees) or --diffuse");
+            }
+            check_angles(&a.theta_i, "--theta-i", 0.0, true, 90.0)?;
+            text.push_str(&format!("theta_i_deg,{cols}\n"));
+            for &ti in &a.theta_i {
+                let (wi, _) = in_plane_directions(ti, 0.0, false);
+                let t = simulate_totals(&slab, Incidence::Collimated(wi), &cfg)?;
+                text.push_str(&format!(
+                    "{ti},{},{}\n",
+                    fmt_estimate(&t.reflectance, rgb),
+                    fmt_estimate(&t.transmittance, rgb)
+                ));
+            }
+        }
+    } else {
+        let Some(range) = &a.theta_o else {
+            bail!("give --theta-o FROM:TO:STEP (BSDF values) or --totals");
+        };
+        if a.theta_i.is_empty() {
+            bail!("--theta-o needs --theta-i LIST (degrees)");
+        }
+        let to = parse_range(range, "--theta-o")?;
+        check_angles(&a.theta_i, "--theta-i", 0.0, true, 90.0)?;
+        check_angles(&to, "--theta-o", -90.0, false, 90.0)?;
+        let cols = if rgb {
+            "r,g,b,r_stderr,g_stderr,b_stderr"
+        } else {
+            "f,stderr"
+        };
+        text.push_str(&format!("kind,theta_i_deg,theta_o_deg,{cols}\n"));
+        for &ti in &a.theta_i {
+            // One set of walks per incident angle serves every viewing direction, R and T.
+            let mut wos = Vec::with_capacity(2 * to.len());
+            for t in [false, true] {
+                for &o in &to {
+                    wos.push(in_plane_directions(ti, o, t).1);
+                }
+            }
+            let (wi, _) = in_plane_directions(ti, 0.0, false);
+            let run = simulate_bsdf(&slab, wi, &wos, &cfg)?;
+            for (k, (kind, _)) in [("R", false), ("T", true)].iter().enumerate() {
+                for (j, &o) in to.iter().enumerate() {
+                    text.push_str(&format!(
+                        "{kind},{ti},{o},{}\n",
+                        fmt_estimate(&run.f[k * to.len() + j], rgb)
+                    ));
+                }
+            }
+        }
+    }
+    match &a.out {
+        Some(path) => paperbsdf_io::write_atomic(path, text.as_bytes())?,
+        None => print!("{text}"),
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(params: &str) -> SimulateArgs {
+        SimulateArgs {
+            params: params.to_string(),
+            theta_i: vec![30.0],
+            theta_o: Some("-60:60:60".into()),
+            totals: false,
+            diffuse: false,
+            samples: Some(256),
+            rel_stderr: None,
+            max_samples: 1 << 20,
+            batches: 8,
+            seed: 3,
+            out: None,
+        }
+    }
+
+    const P: &str = r#"{"d":0.05,"sigma_a":0.5,"sigma_s":[40,50,60],"g_f":0.8,"g_b":-0.3,"w_b":0.2,"eta_f":1.5,"eta_b":1.5,"m_f":0.3,"m_b":0.3,"dist_f":"ggx","dist_b":"beckmann"}"#;
+
+    #[test]
+    fn writes_rgb_table_atomically_and_reproducibly() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("sim.csv");
+        let mut a = args(P);
+        a.out = Some(out.to_str().unwrap().to_string());
+        run(a).unwrap();
+        let text = std::fs::read_to_string(&out).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert!(
+            lines[0].starts_with("# paperbsdf simulate") && lines[0].contains("\"sigma_s\":[40.0,50.0,60.0]"),
+            "{}",
+            lines[0]
+        );
+        assert_eq!(
+            lines[1],
+            "kind,theta_i_deg,theta_o_deg,r,g,b,r_stderr,g_stderr,b_stderr"
+        );
+        assert_eq!(lines.len(), 2 + 6);
+        assert!(
+            lines[2].starts_with("R,30,-60,") && lines[5].starts_with("T,30,-60,"),
+            "{text}"
+        );
+        for l in &lines[2..] {
+            let v: Vec<f64> = l.split(',').skip(3).map(|x| x.parse().unwrap()).collect();
+            assert_eq!(v.len(), 6);
+            assert!(v.iter().all(|x| x.is_finite() && *x >= 0.0), "{l}");
+            assert!(v[0] > 0.0, "{l}");
+        }
+        // Same seed, same output.
+        let out2 = dir.path().join("sim2.csv");
+        let mut a = args(P);
+        a.out = Some(out2.to_str().unwrap().to_string());
+        run(a).unwrap();
+        assert_eq!(text, std::fs::read_to_string(&out2).unwrap());
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            2,
+            "no temporary file left behind"
+        );
+    }
+
+    #[test]
+    fn totals_table() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("t.csv");
+        let p = P.replace("[40,50,60]", "50");
+        let mut a = args(&p);
+        a.theta_o = None;
+        a.totals = true;
+        a.theta_i = vec![0.0, 60.0];
+        a.out = Some(out.to_str().unwrap().to_string());
+        run(a).unwrap();
+        let text = std::fs::read_to_string(&out).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[1], "theta_i_deg,R,R_stderr,T,T_stderr");
+        assert_eq!(lines.len(), 4);
+        for l in &lines[2..] {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            assert!(
+                v[1] > 0.0 && v[3] > 0.0 && v[1] + v[3] <= 1.0 + 4.0 * (v[2] + v[4]),
+                "{l}"
+            );
+        }
+    }
+
+    #[test]
+    fn bad_input_is_a_clear_error() {
+        let e = run(args(&P.replace("\"w_b\":0.2", "\"w_b\":1.2")))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("w_b") && e.contains("1.2") && e.contains("[0, 1]"), "{e}");
+        let e = run(args("/nonexistent/params.json")).unwrap_err().to_string();
+        assert!(e.contains("/nonexistent/params.json"), "{e}");
+        let mut a = args(P);
+        a.theta_i = vec![95.0];
+        let e = run(a).unwrap_err().to_string();
+        assert!(e.contains("--theta-i") && e.contains("95"), "{e}");
+        let mut a = args(P);
+        a.theta_o = Some("-90:90:10".into());
+        let e = run(a).unwrap_err().to_string();
+        assert!(e.contains("--theta-o") && e.contains("-90"), "{e}");
+        let mut a = args(P);
+        a.theta_o = Some("10:0:5".into());
+        assert!(run(a).unwrap_err().to_string().contains("TO is below FROM"));
+        let mut a = args(P);
+        a.samples = None;
+        a.rel_stderr = Some(1.5);
+        assert!(run(a).unwrap_err().to_string().contains("--rel-stderr"));
+        let mut a = args(P);
+        a.batches = 1;
+        assert!(run(a).unwrap_err().to_string().contains("--batches"));
+    }
 }

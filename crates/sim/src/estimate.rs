@@ -1,0 +1,372 @@
+//! Running many walks: independent batches in parallel (rayon), means and
+//! standard errors, optional adaptive stopping at a relative standard error,
+//! and a progress bar.
+//!
+//! Every batch has its own PCG generator (`rand_pcg::Pcg64Mcg`) seeded from the
+//! user's seed, the incident direction, the colour channel and the batch index,
+//! so a run is reproducible for a given seed whatever the number of threads and
+//! whatever other directions are simulated with it. The standard error of each
+//! estimate is the standard deviation of the batch means over `sqrt(batches)`
+//! (all batches have the same number of walks).
+
+use crate::slab::Slab;
+use crate::walk::{Tally, Tracer};
+use indicatif::{ProgressBar, ProgressStyle};
+use paperbsdf_core::geometry::sample_cosine_hemisphere;
+use paperbsdf_core::{DVec3, Rgb};
+use rand::SeedableRng;
+use rand_pcg::Pcg64Mcg;
+use rayon::prelude::*;
+
+/// Size of the per-batch pool of exit-face draws (see `Tracer::with_exit_pool`):
+/// eight per walk, between 256 and 4096.
+fn exit_pool_size(walks_per_batch: u64) -> usize {
+    (walks_per_batch.saturating_mul(8)).clamp(256, 4096) as usize
+}
+
+static COLLISIONS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// Total number of scattering events simulated by this process so far (a diagnostic).
+pub fn collisions_so_far() -> u64 {
+    COLLISIONS.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// How many walks to run and how.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimConfig {
+    /// Walks per incident direction and colour channel (rounded up to a
+    /// multiple of `batches`). With `rel_stderr` it is the first round's count.
+    pub samples: u64,
+    /// Number of independent batches the walks are split into (at least 2).
+    pub batches: u32,
+    /// Seed of the run.
+    pub seed: u64,
+    /// When set, keep adding rounds of batches until every estimate with a
+    /// positive mean has `stderr <= rel_stderr * mean`, or `max_samples` is reached.
+    pub rel_stderr: Option<f64>,
+    /// Cap on the walks per incident direction and channel in adaptive mode.
+    pub max_samples: u64,
+    /// Show a progress bar on standard error (drawn only when it is a terminal).
+    pub progress: bool,
+    /// Also estimate `f` split by scattering order ([`BsdfRun::by_order`]).
+    pub by_order: bool,
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        SimConfig {
+            samples: 1 << 16,
+            batches: 32,
+            seed: 1,
+            rel_stderr: None,
+            max_samples: 1 << 26,
+            progress: false,
+            by_order: false,
+        }
+    }
+}
+
+/// Errors of a simulation request.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SimError {
+    /// A direction that is not a unit vector or lies in the plane of the faces.
+    #[error("{what} = ({x}, {y}, {z}) is not a unit vector off the plane of the faces (need |w| = 1 and w.z != 0)")]
+    BadDirection {
+        /// Which direction.
+        what: &'static str,
+        /// Components.
+        x: f64,
+        /// Components.
+        y: f64,
+        /// Components.
+        z: f64,
+    },
+    /// A configuration value out of range.
+    #[error("simulation setting `{name}` = {value}: {message}")]
+    BadConfig {
+        /// The setting.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+        /// What is allowed.
+        message: &'static str,
+    },
+}
+
+/// A Monte Carlo estimate per colour channel with its standard error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Estimate {
+    /// Mean.
+    pub mean: Rgb,
+    /// Standard error of the mean (from the spread of independent batch means).
+    pub stderr: Rgb,
+}
+
+/// Result of [`simulate_bsdf`] for one incident direction.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BsdfRun {
+    /// `f(wi, wo_j)` without cosine for each requested `wo_j` (delta lobes excluded).
+    pub f: Vec<Estimate>,
+    /// Total reflectance (flux leaving through the lit face per unit incident flux).
+    pub reflectance: Estimate,
+    /// Total transmittance (flux leaving through the other face).
+    pub transmittance: Estimate,
+    /// With [`SimConfig::by_order`]: per `wo_j`, `f` from paths with 0, 1 and
+    /// 2 or more volume scattering events (they sum to `f`). Order 0 is the
+    /// lit face's reflection plus light that crossed the slab unscattered
+    /// (internal reflections included); order 1 is single scattering with any
+    /// surface bounces; the rest is multiple scattering.
+    pub by_order: Option<Vec<[Estimate; 3]>>,
+    /// Walks run per colour channel.
+    pub samples: u64,
+}
+
+/// Totals of [`simulate_totals`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Totals {
+    /// Total reflectance.
+    pub reflectance: Estimate,
+    /// Total transmittance.
+    pub transmittance: Estimate,
+    /// Walks run per colour channel.
+    pub samples: u64,
+}
+
+/// How the incident light is distributed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Incidence {
+    /// A collimated beam from direction `wi` (unit, toward the light).
+    Collimated(DVec3),
+    /// Diffuse (Lambertian, cosine-weighted) light on the front (`true`) or back face.
+    Diffuse {
+        /// Whether the light falls on the front face.
+        front: bool,
+    },
+}
+
+fn check_dir(what: &'static str, w: DVec3) -> Result<(), SimError> {
+    if !(w.is_finite() && (w.length() - 1.0).abs() < 1e-6 && w.z != 0.0) {
+        return Err(SimError::BadDirection {
+            what,
+            x: w.x,
+            y: w.y,
+            z: w.z,
+        });
+    }
+    Ok(())
+}
+
+fn check_config(c: &SimConfig) -> Result<(), SimError> {
+    if c.batches < 2 {
+        return Err(SimError::BadConfig {
+            name: "batches",
+            value: c.batches as f64,
+            message: "need at least 2 batches",
+        });
+    }
+    if c.samples == 0 {
+        return Err(SimError::BadConfig {
+            name: "samples",
+            value: 0.0,
+            message: "need at least one walk",
+        });
+    }
+    if let Some(x) = c.rel_stderr {
+        if !(x > 0.0 && x.is_finite()) {
+            return Err(SimError::BadConfig {
+                name: "rel_stderr",
+                value: x,
+                message: "must be positive and finite",
+            });
+        }
+    }
+    Ok(())
+}
+
+/// SplitMix64 finaliser, to derive independent seeds.
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+fn incidence_key(inc: Incidence) -> u64 {
+    match inc {
+        Incidence::Collimated(w) => mix(w.x.to_bits() ^ mix(w.y.to_bits() ^ mix(w.z.to_bits()))),
+        Incidence::Diffuse { front } => mix(0xd1ff_u64 + front as u64),
+    }
+}
+
+/// Runs the walks of one incident light distribution: batch means per
+/// channel, each a vector `[f_0, .., f_{n-1}, R, T]`.
+fn run(slab: &Slab, inc: Incidence, wos: &[DVec3], cfg: &SimConfig, pb: &ProgressBar) -> (Vec<Estimate>, u64) {
+    let reps = slab.distinct_channels();
+    let channels: Vec<usize> = (0..3).filter(|&c| reps[c] == c).collect();
+    let nb = cfg.batches as u64;
+    let per_batch = cfg.samples.div_ceil(nb).max(1);
+    let key = incidence_key(inc);
+    let n = wos.len();
+    let n_out = n + 2 + if cfg.by_order { 3 * n } else { 0 };
+    pb.set_length(per_batch * nb * channels.len() as u64);
+
+    let run_batch = |c: usize, b: u64| -> Vec<f64> {
+        let mut rng = Pcg64Mcg::seed_from_u64(mix(cfg.seed ^ mix(key ^ mix(((c as u64) << 48) ^ b))));
+        let tracer = Tracer::with_exit_pool(slab, c, wos, exit_pool_size(per_batch), &mut rng);
+        let tr = &tracer;
+        let (mut sum, mut one) = if cfg.by_order {
+            (Tally::with_orders(n), Tally::with_orders(n))
+        } else {
+            (Tally::new(n), Tally::new(n))
+        };
+        for i in 0..per_batch {
+            one.clear();
+            let wi = match inc {
+                Incidence::Collimated(w) => w,
+                Incidence::Diffuse { front } => {
+                    use rand::Rng;
+                    let w = sample_cosine_hemisphere([rng.gen(), rng.gen()]);
+                    if front {
+                        w
+                    } else {
+                        DVec3::new(w.x, w.y, -w.z)
+                    }
+                }
+            };
+            if wi.z != 0.0 {
+                tr.walk(wi, &mut rng, &mut one);
+            }
+            sum.add(&one);
+            if i % 256 == 255 {
+                pb.inc(256);
+            }
+        }
+        pb.inc(per_batch % 256);
+        COLLISIONS.fetch_add(sum.collisions, std::sync::atomic::Ordering::Relaxed);
+        let inv = 1.0 / per_batch as f64;
+        let mut v: Vec<f64> = sum.f.iter().map(|x| x * inv).collect();
+        v.push(sum.r * inv);
+        v.push(sum.t * inv);
+        if let Some(b) = &sum.by_order {
+            for k in 0..3 {
+                v.extend(b.iter().map(|x| x[k] * inv));
+            }
+        }
+        v
+    };
+
+    // batch_means[c][b] = vector of n_out means.
+    let mut batch_means: Vec<Vec<Vec<f64>>> = vec![Vec::new(); 3];
+    let mut done_batches = 0u64;
+    let mut target_batches = nb;
+    loop {
+        let jobs: Vec<(usize, u64)> = channels
+            .iter()
+            .flat_map(|&c| (done_batches..target_batches).map(move |b| (c, b)))
+            .collect();
+        let res: Vec<Vec<f64>> = jobs.par_iter().map(|&(c, b)| run_batch(c, b)).collect();
+        for ((c, _), r) in jobs.iter().zip(res) {
+            batch_means[*c].push(r);
+        }
+        done_batches = target_batches;
+        let est = summarise(&batch_means, &reps, n_out);
+        let Some(x) = cfg.rel_stderr else {
+            return (est, done_batches * per_batch);
+        };
+        // Worst ratio (stderr / (x mean)) over estimates with a positive mean.
+        let mut worst: f64 = 0.0;
+        for e in &est {
+            for k in 0..3 {
+                if e.mean.0[k] > 0.0 {
+                    worst = worst.max(e.stderr.0[k] / (x * e.mean.0[k]));
+                }
+            }
+        }
+        let max_batches = (cfg.max_samples / per_batch).max(nb);
+        if worst <= 1.0 || done_batches >= max_batches {
+            return (est, done_batches * per_batch);
+        }
+        // Walks needed scale with the square of the ratio; add 10% and at least one round's worth / 4.
+        let need = ((done_batches as f64) * worst * worst * 1.1).ceil() as u64;
+        target_batches = need.max(done_batches + nb / 4 + 1).min(max_batches);
+        pb.inc_length((target_batches - done_batches) * per_batch * channels.len() as u64);
+    }
+}
+
+fn summarise(batch_means: &[Vec<Vec<f64>>], reps: &[usize; 3], n_out: usize) -> Vec<Estimate> {
+    let mut out = vec![
+        Estimate {
+            mean: Rgb::ZERO,
+            stderr: Rgb::ZERO
+        };
+        n_out
+    ];
+    for c in 0..3 {
+        let bm = &batch_means[reps[c]];
+        let n = bm.len() as f64;
+        for (j, o) in out.iter_mut().enumerate() {
+            let mean = bm.iter().map(|v| v[j]).sum::<f64>() / n;
+            let var = bm.iter().map(|v| (v[j] - mean).powi(2)).sum::<f64>() / (n - 1.0);
+            o.mean.0[c] = mean;
+            o.stderr.0[c] = (var / n).sqrt();
+        }
+    }
+    out
+}
+
+fn progress_bar(cfg: &SimConfig, msg: &str) -> ProgressBar {
+    if !cfg.progress {
+        return ProgressBar::hidden();
+    }
+    let pb = ProgressBar::new(0);
+    pb.set_style(
+        ProgressStyle::with_template("{msg} [{elapsed_precise}] {wide_bar} {pos}/{len} walks ({per_sec}, eta {eta})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    pb.set_message(msg.to_string());
+    pb
+}
+
+/// Simulates `f(wi, wo)` (without cosine) for one incident direction `wi` and
+/// every `wo` in `wos` (unit vectors, slab frame, either side), with the total
+/// reflectance and transmittance of the same walks.
+pub fn simulate_bsdf(slab: &Slab, wi: DVec3, wos: &[DVec3], cfg: &SimConfig) -> Result<BsdfRun, SimError> {
+    check_config(cfg)?;
+    check_dir("wi", wi)?;
+    for &wo in wos {
+        check_dir("wo", wo)?;
+    }
+    let pb = progress_bar(cfg, "simulate");
+    let (est, samples) = run(slab, Incidence::Collimated(wi), wos, cfg, &pb);
+    pb.finish_and_clear();
+    let n = wos.len();
+    let by_order = cfg.by_order.then(|| {
+        (0..n)
+            .map(|j| [est[n + 2 + j], est[2 * n + 2 + j], est[3 * n + 2 + j]])
+            .collect()
+    });
+    Ok(BsdfRun {
+        f: est[..n].to_vec(),
+        reflectance: est[n],
+        transmittance: est[n + 1],
+        by_order,
+        samples,
+    })
+}
+
+/// Simulates the total reflectance and transmittance for collimated or
+/// diffuse incident light.
+pub fn simulate_totals(slab: &Slab, inc: Incidence, cfg: &SimConfig) -> Result<Totals, SimError> {
+    check_config(cfg)?;
+    if let Incidence::Collimated(wi) = inc {
+        check_dir("wi", wi)?;
+    }
+    let pb = progress_bar(cfg, "totals");
+    let (est, samples) = run(slab, inc, &[], cfg, &pb);
+    pb.finish_and_clear();
+    Ok(Totals {
+        reflectance: est[0],
+        transmittance: est[1],
+        samples,
+    })
+}

@@ -1,0 +1,814 @@
+//! One random walk of light through the slab, and the estimators it feeds.
+//!
+//! # The walk (light tracing in depth only)
+//! Light arrives from direction `wi` (pointing toward the light) at the face
+//! it faces, carrying unit flux. Every event is sampled exactly from the
+//! physical system: surface events from the face's Walter BSDF in importance
+//! transport ([`RoughDielectric::sample_mode`], whose weight is the fraction of
+//! flux carried; smooth and index-matched faces are delta events), free paths
+//! from `sigma_t` (Beer-Lambert), scattering directions from the phase
+//! function. Absorption is implicit (the weight is multiplied by the albedo at
+//! each collision) with Russian roulette below a weight of 0.01. Only depth
+//! matters: the slab is laterally infinite, so lateral position is never tracked.
+//!
+//! # Totals
+//! The flux that leaves through the lit face is the reflectance `R`, through the
+//! other face the transmittance `T` (both include everything: surface
+//! reflection, unscattered light, all orders of scattering).
+//!
+//! # The BSDF value by next-event estimation
+//! For a laterally infinite slab lit by a collimated beam of unit irradiance
+//! (perpendicular to the beam), the flux per unit area entering is
+//! `|cos wi|`, and the radiance leaving toward `wo` is `|cos wi| q(wo) / |cos wo|`,
+//! where `q(wo)` is the flux density per steradian of the exit direction per unit
+//! incident flux. So `f(wi, wo) = q(wo) / |cos wo|`: no angular binning is
+//! needed if `q` is estimated by next-event estimation. A vertex (a volume
+//! scattering or a surface event) that sends flux into directions `w` inside with
+//! density `q_v(w)` (the phase function, or `f_imp(w, w_from) |cos w|` of a face)
+//! contributes, through the exit face `x` at depth distance `dz`,
+//!
+//! `C = W * integral q_v(w) exp(-sigma_t dz / |w_z|) f_x(-w -> wo) dw`,
+//!
+//! where `f_x(-w -> wo) = eval_mode(-w, wo, Radiance)` of face `x` (the flux
+//! density per steradian leaving toward `wo` is that times `|cos wo|`, which
+//! cancels against the `1 / |cos wo|` above). The integral is estimated by
+//! multiple importance sampling (balance heuristic, Veach 1997) of two
+//! strategies: the direction the walk itself draws from `q_v` (no extra cost),
+//! and a direction drawn from the exit face's own BSDF sampled from `wo`
+//! (the camera-side strategy of a volumetric path tracer). Delta lobes are
+//! handled by their only strategy: a smooth or index-matched exit face by the
+//! refraction of `wo`, a smooth face vertex or a `|g| = 1` lobe by its
+//! expected value. Paths whose every event is a delta (the mirror reflection of
+//! a smooth face, unscattered light through two smooth faces) are Dirac deltas
+//! in `wo` and, as in `Bsdf::eval`, are not part of `f`; they are in the totals.
+//! Add to this the direct Walter reflection of the lit face when `wo` is on the
+//! lit side. The result is unbiased with no angular binning.
+//!
+//! The same vertex contributes to every requested `wo`, so one set of walks
+//! estimates a whole in-plane curve (reflection and transmission) for one `wi`.
+//!
+//! # Cost, without bias
+//! - The phase-sampling strategy needs a BSDF evaluation per target and vertex;
+//!   it is used at volume vertices only when the phase function's peak density
+//!   is comparable to the exit lobe's typical density (a strongly forward
+//!   phase function behind a rough face). Otherwise the exit-sampling strategy
+//!   alone is unbiased with bounded weights: with visible-normal sampling
+//!   `f / p2 <= 1 / |cos|`, so a contribution is at most `p_max T / |cos|`.
+//! - Exit draws depend only on `wo`, so a batch may pre-draw a pool of them
+//!   ([`Tracer::with_exit_pool`]) and pick one at random per vertex.
+//! - A contribution whose bound (weight x transmittance x exit BSDF) is below
+//!   `NEE_RR_SCALE` is evaluated with probability bound / `NEE_RR_SCALE` and
+//!   divided by it (Russian roulette): vertices deep in the slab, seen through
+//!   many mean free paths, then cost almost nothing.
+//!
+//! # Radiance and flux
+//! With `f_imp(a, b) = eval_mode(a, b, Importance) = eval_mode(b, a, Radiance)`
+//! (the adjoint of Veach 1997, section 5.2), the light-tracing estimator here
+//! and a camera-side volumetric path tracer (Mitsuba's `volpath`) estimate the
+//! same integral. With `eta_f != eta_b` the slab is not a consistent physical
+//! medium and the transmission is not reciprocal; the simulator then computes
+//! exactly what Mitsuba computes for the same two interfaces.
+
+use crate::slab::{Face, Medium, Slab};
+use paperbsdf_core::phase::{hg, sample_hg_cos};
+use paperbsdf_core::{DVec3, RoughDielectric, TransportMode};
+use rand::Rng;
+use std::f64::consts::PI;
+
+/// Weight below which Russian roulette is played.
+const RR_THRESHOLD: f64 = 0.01;
+/// Next-event contributions whose bound is below this are subject to Russian
+/// roulette (played with survival probability bound / NEE_RR_SCALE): deep
+/// vertices seen through many mean free paths cost almost nothing.
+const NEE_RR_SCALE: f64 = 2e-3;
+/// Volume vertices use MIS for a rough exit only when the phase function's
+/// peak density exceeds this fraction of the exit lobe's typical density.
+const MIS_PHASE_RATIO: f64 = 1.0;
+/// Survival probability of Russian roulette.
+const RR_SURVIVAL: f64 = 0.1;
+
+/// How light leaves the slab toward one requested viewing direction.
+#[derive(Clone, Copy, Debug)]
+enum Exit {
+    /// A rough exit face: both NEE strategies.
+    Rough(RoughDielectric),
+    /// A smooth or index-matched exit face: the only inside direction that
+    /// reaches `wo` is `-w_s` (propagation), with radiance factor `t_rad`.
+    Delta { w_s: DVec3, t_rad: f64 },
+    /// No light reaches `wo` through this face (cannot happen from air).
+    Blocked,
+}
+
+/// One draw of the exit face's BSDF sampled from `wo` (radiance transport):
+/// the propagation direction inside that reaches `wo` (slab frame), the BSDF
+/// value and the density. `p2 = 0` marks a draw that produced no inside
+/// direction (a reflection sample or a failed draw): it contributes zero.
+#[derive(Clone, Copy, Debug)]
+struct ExitDraw {
+    w: DVec3,
+    f: f64,
+    p2: f64,
+}
+
+/// One requested viewing direction `wo`.
+#[derive(Clone, Debug)]
+struct Target {
+    /// The face through which the slab is seen from `wo`.
+    face: Face,
+    /// `wo` in that face's local frame (`z > 0`).
+    wo_l: DVec3,
+    exit: Exit,
+    /// Pre-drawn exit samples (empty: draw afresh at every vertex).
+    pool: Vec<ExitDraw>,
+    /// A typical exit BSDF value (mean over transmitted draws), the scale of
+    /// next-event contributions for Russian roulette.
+    f_scale: f64,
+    /// Whether volume vertices combine both strategies by MIS for this target
+    /// (see [`Tracer::new`]); otherwise only the exit-face strategy is used there.
+    mis_volume: bool,
+}
+
+/// A vertex of the walk that sends light into the slab.
+#[derive(Clone, Copy, Debug)]
+enum Vertex {
+    /// A scattering event at depth `z` of light propagating along `prev`.
+    Volume { z: f64, prev: DVec3 },
+    /// A surface event at `face` for light arriving from `w_from_l` (face-local,
+    /// pointing away from the surface toward where the light came from).
+    Surface { face: Face, w_from_l: DVec3 },
+}
+
+/// Per-walk sums: BSDF contributions per target, reflected and transmitted flux.
+#[derive(Clone, Debug, Default)]
+pub struct Tally {
+    /// Sum of next-event contributions to `f(wi, wo_j)` per requested `wo_j`.
+    pub f: Vec<f64>,
+    /// Flux that left through the lit face.
+    pub r: f64,
+    /// Flux that left through the other face.
+    pub t: f64,
+    /// Number of scattering events (collisions with scattering) in the walk(s).
+    pub collisions: u64,
+    /// When `Some`, the contributions to `f` split by the number of volume
+    /// scattering events on the path: `[0, 1, 2 or more]` per viewing direction
+    /// (0: surface reflection and unscattered light, including internal
+    /// reflections; 1: single scattering; the rest: multiple scattering).
+    pub by_order: Option<Vec<[f64; 3]>>,
+    /// Scattering events so far in the current walk (set by the walk).
+    order: usize,
+}
+
+impl Tally {
+    /// A zero tally for `n` viewing directions.
+    pub fn new(n: usize) -> Self {
+        Tally {
+            f: vec![0.0; n],
+            r: 0.0,
+            t: 0.0,
+            collisions: 0,
+            by_order: None,
+            order: 0,
+        }
+    }
+    /// Adds `o` into `self`.
+    pub fn add(&mut self, o: &Tally) {
+        for (a, b) in self.f.iter_mut().zip(&o.f) {
+            *a += b;
+        }
+        self.r += o.r;
+        self.t += o.t;
+        self.collisions += o.collisions;
+        if let (Some(a), Some(b)) = (self.by_order.as_mut(), o.by_order.as_ref()) {
+            for (x, y) in a.iter_mut().zip(b) {
+                for k in 0..3 {
+                    x[k] += y[k];
+                }
+            }
+        }
+    }
+
+    /// A zero tally for `n` viewing directions that also splits `f` by scattering order.
+    pub fn with_orders(n: usize) -> Self {
+        Tally {
+            by_order: Some(vec![[0.0; 3]; n]),
+            ..Tally::new(n)
+        }
+    }
+
+    /// Resets every sum to zero (keeping the sizes).
+    pub fn clear(&mut self) {
+        self.f.iter_mut().for_each(|v| *v = 0.0);
+        if let Some(b) = self.by_order.as_mut() {
+            b.iter_mut().for_each(|v| *v = [0.0; 3]);
+        }
+        self.r = 0.0;
+        self.t = 0.0;
+        self.collisions = 0;
+        self.order = 0;
+    }
+
+    #[inline]
+    fn add_f(&mut self, j: usize, c: f64) {
+        self.f[j] += c;
+        if let Some(b) = self.by_order.as_mut() {
+            b[j][self.order.min(2)] += c;
+        }
+    }
+}
+
+/// The random walk for one colour channel and a fixed set of viewing directions.
+#[derive(Clone, Debug)]
+pub struct Tracer<'a> {
+    slab: &'a Slab,
+    med: Medium,
+    targets: Vec<Target>,
+    /// Phase lobes with `|g| < 1`: (weight, g).
+    smooth_lobes: Vec<(f64, f64)>,
+    /// Phase lobes with `|g| = 1` (Dirac deltas, forward or backward): (weight, g).
+    delta_lobes: Vec<(f64, f64)>,
+    /// All lobes with positive weight, for sampling: (cumulative weight, g, is_delta).
+    lobes: Vec<(f64, f64, bool)>,
+    /// Whether any rough target uses MIS at volume vertices.
+    any_mis_volume: bool,
+}
+
+impl<'a> Tracer<'a> {
+    /// A tracer for channel `channel` of `slab` and viewing directions `wos`
+    /// (unit vectors, slab frame; `wo.z != 0`).
+    pub fn new(slab: &'a Slab, channel: usize, wos: &[DVec3]) -> Self {
+        let targets = wos
+            .iter()
+            .map(|&wo| {
+                let face = Face::toward(wo);
+                let wo_l = face.local(wo);
+                let b = *slab.face(face);
+                let exit = match b.specular_lobes(wo_l, TransportMode::Radiance) {
+                    None => Exit::Rough(b),
+                    Some((_, t_rad, Some(dir_l))) if t_rad > 0.0 => Exit::Delta {
+                        w_s: face.local(dir_l),
+                        t_rad,
+                    },
+                    Some(_) => Exit::Blocked,
+                };
+                Target {
+                    face,
+                    wo_l,
+                    exit,
+                    pool: Vec::new(),
+                    f_scale: 0.0,
+                    mis_volume: true,
+                }
+            })
+            .collect();
+        let p = slab.phase;
+        let mut smooth_lobes = Vec::new();
+        let mut delta_lobes = Vec::new();
+        let mut lobes = Vec::new();
+        let mut cum = 0.0;
+        for (w, g) in [(1.0 - p.w_b, p.g_f), (p.w_b, p.g_b)] {
+            if w <= 0.0 {
+                continue;
+            }
+            let is_delta = g.abs() >= 1.0;
+            if is_delta {
+                delta_lobes.push((w, g));
+            } else {
+                smooth_lobes.push((w, g));
+            }
+            cum += w;
+            lobes.push((cum, g, is_delta));
+        }
+        let mut t = Tracer {
+            slab,
+            med: slab.medium(channel),
+            targets,
+            smooth_lobes,
+            delta_lobes,
+            lobes,
+            any_mis_volume: false,
+        };
+        // The scale of each rough exit for Russian roulette, from a fixed set of draws.
+        // Whether the phase function's peak is comparable to the exit lobe's
+        // typical density (E[p2] under its own sampling): only then can
+        // phase sampling beat exit sampling at a volume vertex, and only then is
+        // its evaluation (a BSDF eval and pdf per target) worth its cost.
+        let phase_peak: f64 = t
+            .smooth_lobes
+            .iter()
+            .map(|&(w, g)| w * (1.0 + g.abs()) / (4.0 * PI * (1.0 - g.abs()).powi(2)))
+            .sum();
+        let mut rng = rand_pcg::Pcg64Mcg::new(0x5eed);
+        for tg in &mut t.targets {
+            let draws = draw_exits(tg, 256, &mut rng);
+            // No transmitted draw among 256: never play roulette on this target.
+            tg.f_scale = match f_scale(&draws) {
+                f if f > 0.0 => f,
+                _ => f64::INFINITY,
+            };
+            let (sp, n) = draws
+                .iter()
+                .filter(|e| e.p2 > 0.0)
+                .fold((0.0, 0usize), |(s, n), e| (s + e.p2, n + 1));
+            tg.mis_volume = n == 0 || phase_peak > MIS_PHASE_RATIO * sp / n as f64;
+            t.any_mis_volume |= tg.mis_volume && matches!(tg.exit, Exit::Rough(_));
+        }
+        t
+    }
+
+    /// [`Tracer::new`] with a pool of `size` pre-drawn exit samples per rough
+    /// exit, drawn from `rng`; every next-event estimate then picks a uniformly
+    /// random member of the pool instead of sampling the exit face afresh.
+    /// Each pick is still an exact draw, so the estimator stays unbiased; the
+    /// pool is shared by all walks of a batch, so batches must each have their
+    /// own pool for batch standard errors to be valid.
+    pub fn with_exit_pool<R: Rng>(slab: &'a Slab, channel: usize, wos: &[DVec3], size: usize, rng: &mut R) -> Self {
+        let mut t = Tracer::new(slab, channel, wos);
+        for tg in &mut t.targets {
+            tg.pool = draw_exits(tg, size, rng);
+        }
+        t
+    }
+
+    /// Number of viewing directions.
+    pub fn n_targets(&self) -> usize {
+        self.targets.len()
+    }
+
+    /// The non-delta part of the phase function at cosine `c`.
+    #[inline]
+    fn phase_smooth(&self, c: f64) -> f64 {
+        self.smooth_lobes.iter().map(|&(w, g)| w * hg(c, g)).sum()
+    }
+
+    /// Transmittance along `w` over a depth difference `dz`.
+    #[inline]
+    fn transmittance(&self, dz: f64, w: DVec3) -> f64 {
+        if self.med.sigma_t == 0.0 {
+            1.0
+        } else {
+            (-self.med.sigma_t * dz / w.z.abs()).exp()
+        }
+    }
+
+    #[inline]
+    fn depth(&self, v: Vertex) -> f64 {
+        match v {
+            Vertex::Volume { z, .. } => z,
+            Vertex::Surface { face, .. } => face.z(self.slab.d),
+        }
+    }
+
+    /// The vertex's flux density `q_v(w)` into propagation direction `w`
+    /// (non-delta part) and the density with which the walk draws `w`.
+    #[inline]
+    fn q_p(&self, v: Vertex, w: DVec3) -> (f64, f64) {
+        match v {
+            Vertex::Volume { prev, .. } => {
+                let q = self.phase_smooth(prev.dot(w));
+                (q, q)
+            }
+            Vertex::Surface { face, w_from_l } => {
+                let b = self.slab.face(face);
+                let wl = face.local(w);
+                let q = b.eval_mode(wl, w_from_l, TransportMode::Importance) * w.z.abs();
+                if q == 0.0 {
+                    return (0.0, 0.0);
+                }
+                (q, b.pdf_dir(wl, w_from_l))
+            }
+        }
+    }
+
+    /// Next-event estimation by sampling the exit face from `wo` (and the only
+    /// strategy for a delta exit face), for every target reachable from `v`.
+    fn nee_exit<R: Rng>(&self, v: Vertex, weight: f64, rng: &mut R, tally: &mut Tally) {
+        let z = self.depth(v);
+        let skip = match v {
+            Vertex::Surface { face, .. } => Some(face),
+            Vertex::Volume { .. } => None,
+        };
+        for (j, t) in self.targets.iter().enumerate() {
+            if Some(t.face) == skip {
+                continue;
+            }
+            let dz = (z - t.face.z(self.slab.d)).abs();
+            match t.exit {
+                Exit::Rough(_) => {
+                    let e = if t.pool.is_empty() {
+                        let mut one = [ExitDraw {
+                            w: DVec3::ZERO,
+                            f: 0.0,
+                            p2: 0.0,
+                        }];
+                        one[0] = draw_exit(t, rng.gen(), [rng.gen(), rng.gen()]);
+                        one[0]
+                    } else {
+                        t.pool[rng.gen_range(0..t.pool.len())]
+                    };
+                    if e.p2 == 0.0 {
+                        continue;
+                    }
+                    let tr = self.transmittance(dz, e.w);
+                    // Contribution <= weight * tr * f (the MIS factor q / (q + p2) <= 1).
+                    let Some(rr) = nee_roulette(weight * tr * e.f, rng) else {
+                        continue;
+                    };
+                    let (q, p1) = self.q_p(v, e.w);
+                    if q <= 0.0 {
+                        continue;
+                    }
+                    // (f / p2) * p2 / (p1 + p2) with MIS, f / p2 without.
+                    let p1 = if t.mis_volume || matches!(v, Vertex::Surface { .. }) {
+                        p1
+                    } else {
+                        0.0
+                    };
+                    let c = rr * weight * q * tr * e.f / (p1 + e.p2);
+                    if c.is_finite() {
+                        tally.add_f(j, c);
+                    }
+                }
+                Exit::Delta { w_s, t_rad } => {
+                    let w = -w_s;
+                    let (q, _) = self.q_p(v, w);
+                    if q > 0.0 {
+                        tally.add_f(j, weight * q * self.transmittance(dz, w) * t_rad / w.z.abs());
+                    }
+                }
+                Exit::Blocked => {}
+            }
+        }
+    }
+
+    /// Next-event estimation along the direction `w` the walk drew at `v` (or a
+    /// delta lobe's direction, `p1 = None`, weighted by the lobe's expected
+    /// value), for the rough targets on the face `w` heads for.
+    fn nee_dir<R: Rng>(&self, v: Vertex, weight: f64, w: DVec3, p1: Option<f64>, rng: &mut R, tally: &mut Tally) {
+        if w.z == 0.0 || weight == 0.0 {
+            return;
+        }
+        let x = Face::toward(w);
+        let dz = (self.depth(v) - x.z(self.slab.d)).abs();
+        let mut tr = f64::NAN;
+        for (j, t) in self.targets.iter().enumerate() {
+            if t.face != x {
+                continue;
+            }
+            let Exit::Rough(b) = t.exit else { continue };
+            if p1.is_some() && !t.mis_volume && matches!(v, Vertex::Volume { .. }) {
+                continue; // exit sampling alone covers this target at volume vertices
+            }
+            if tr.is_nan() {
+                tr = self.transmittance(dz, w);
+            }
+            let Some(rr) = nee_roulette(weight * tr * t.f_scale, rng) else {
+                continue;
+            };
+            let ws_l = x.local(-w);
+            let f = b.eval_mode(ws_l, t.wo_l, TransportMode::Radiance);
+            if f == 0.0 {
+                continue;
+            }
+            let mis = match p1 {
+                None => 1.0,
+                Some(p1) => p1 / (p1 + b.pdf_dir(ws_l, t.wo_l)),
+            };
+            let c = rr * weight * tr * f * mis;
+            if c.is_finite() {
+                tally.add_f(j, c);
+            }
+        }
+    }
+
+    /// A surface event at `face` for light arriving from `w_from_l` (face-local)
+    /// with weight `weight`: next-event estimation, then the sampled event.
+    /// Returns the new propagation direction and weight if the light stays in
+    /// the slab; exits are added to the totals (`lit` is the lit face).
+    #[allow(clippy::too_many_arguments)]
+    fn surface_vertex<R: Rng, E: FnMut(DVec3, f64)>(
+        &self,
+        face: Face,
+        w_from_l: DVec3,
+        weight: f64,
+        lit: Face,
+        rng: &mut R,
+        tally: &mut Tally,
+        on_exit: &mut E,
+    ) -> Option<(DVec3, f64)> {
+        let b = self.slab.face(face);
+        let v = Vertex::Surface { face, w_from_l };
+        let from_outside = w_from_l.z > 0.0;
+        let mut exit = |tally: &mut Tally, w: f64, dir_l: DVec3| {
+            if face == lit {
+                tally.r += w;
+            } else {
+                tally.t += w;
+            }
+            on_exit(face.local(dir_l), w);
+        };
+        match b.specular_lobes(w_from_l, TransportMode::Importance) {
+            None => {
+                self.nee_exit(v, weight, rng, tally);
+                let (uc, u0, u1) = (rng.gen::<f64>(), rng.gen::<f64>(), rng.gen::<f64>());
+                let s = b.sample_mode(w_from_l, uc, [u0, u1], TransportMode::Importance)?;
+                let sw = s.weight().0[0];
+                if !(sw.is_finite() && sw > 0.0) {
+                    return None;
+                }
+                if s.wi.z > 0.0 {
+                    exit(tally, weight * sw, s.wi);
+                    return None;
+                }
+                let w = face.local(s.wi);
+                let nw = weight * sw;
+                self.nee_dir(v, nw, w, Some(s.pdf), rng, tally);
+                Some((w, nw))
+            }
+            Some((r, t, t_dir)) => {
+                // Delta interface: the lobe into the slab and the lobe out of it.
+                let mirror = DVec3::new(-w_from_l.x, -w_from_l.y, w_from_l.z);
+                let (into, out) = if from_outside {
+                    ((t, t_dir.unwrap_or(DVec3::ZERO)), (r, mirror))
+                } else {
+                    ((r, mirror), (t, t_dir.unwrap_or(DVec3::ZERO)))
+                };
+                let total = into.0 + out.0;
+                if total <= 0.0 {
+                    return None;
+                }
+                let w_into = face.local(into.1);
+                if into.0 > 0.0 {
+                    self.nee_dir(v, weight * into.0, w_into, None, rng, tally);
+                }
+                if rng.gen::<f64>() * total < into.0 {
+                    Some((w_into, weight * total))
+                } else {
+                    exit(tally, weight * total, out.1);
+                    None
+                }
+            }
+        }
+    }
+
+    /// One walk of unit flux arriving from `wi` (unit, slab frame, `wi.z != 0`);
+    /// adds its contributions to `tally`.
+    pub fn walk<R: Rng>(&self, wi: DVec3, rng: &mut R, tally: &mut Tally) {
+        self.walk_with_exits(wi, rng, tally, &mut |_, _| {});
+    }
+
+    /// [`Tracer::walk`], also reporting every exit of light from the slab to
+    /// `on_exit(direction, flux)` (direction in the slab frame, pointing away
+    /// from the slab): the analog estimator, for checks of the next-event one.
+    pub fn walk_with_exits<R: Rng, E: FnMut(DVec3, f64)>(
+        &self,
+        wi: DVec3,
+        rng: &mut R,
+        tally: &mut Tally,
+        on_exit: &mut E,
+    ) {
+        let d = self.slab.d;
+        tally.order = 0;
+        let lit = Face::lit_by(wi);
+        let wi_l = lit.local(wi);
+        // The lit face's own reflection toward viewers on its side.
+        let b = self.slab.face(lit);
+        for (j, t) in self.targets.iter().enumerate() {
+            if t.face == lit {
+                tally.add_f(j, b.eval_mode(wi_l, t.wo_l, TransportMode::Radiance));
+            }
+        }
+        let Some((mut dir, mut weight)) = self.surface_vertex(lit, wi_l, 1.0, lit, rng, tally, on_exit) else {
+            return;
+        };
+        let mut z = lit.z(d);
+        loop {
+            if weight < RR_THRESHOLD {
+                if rng.gen::<f64>() < RR_SURVIVAL {
+                    weight /= RR_SURVIVAL;
+                } else {
+                    return;
+                }
+            }
+            if dir.z == 0.0 {
+                return; // parallel to the faces: measure zero
+            }
+            let x = Face::toward(dir);
+            let dist = (x.z(d) - z) / dir.z;
+            let t = if self.med.sigma_t > 0.0 {
+                -(1.0 - rng.gen::<f64>()).ln() / self.med.sigma_t
+            } else {
+                f64::INFINITY
+            };
+            if t < dist {
+                z = (z + t * dir.z).clamp(-d, 0.0);
+                weight *= self.med.albedo;
+                if weight == 0.0 {
+                    return;
+                }
+                tally.collisions += 1;
+                tally.order += 1;
+                let v = Vertex::Volume { z, prev: dir };
+                self.nee_exit(v, weight, rng, tally);
+                for &(wl, g) in &self.delta_lobes {
+                    self.nee_dir(v, weight * wl, if g > 0.0 { dir } else { -dir }, None, rng, tally);
+                }
+                // Draw a lobe, then a direction from it.
+                let ul = rng.gen::<f64>() * self.lobes.last().map_or(1.0, |l| l.0);
+                let &(_, g, is_delta) = self
+                    .lobes
+                    .iter()
+                    .find(|l| ul < l.0)
+                    .unwrap_or(&self.lobes[self.lobes.len() - 1]);
+                let new_dir = if is_delta {
+                    if g > 0.0 {
+                        dir
+                    } else {
+                        -dir
+                    }
+                } else {
+                    let c = sample_hg_cos(g, rng.gen());
+                    direction_at(dir, c, rng)
+                };
+                if !is_delta && self.any_mis_volume {
+                    let p1 = self.phase_smooth(dir.dot(new_dir));
+                    self.nee_dir(v, weight, new_dir, Some(p1), rng, tally);
+                }
+                dir = new_dir;
+            } else {
+                z = x.z(d);
+                match self.surface_vertex(x, x.local(-dir), weight, lit, rng, tally, on_exit) {
+                    Some((nd, nw)) => {
+                        dir = nd;
+                        weight = nw;
+                    }
+                    None => return,
+                }
+            }
+        }
+    }
+}
+
+/// Russian roulette on a next-event contribution bounded by about `bound`:
+/// `Some(1 / survival)` when it is to be evaluated, `None` when it is skipped.
+#[inline]
+fn nee_roulette<R: Rng>(bound: f64, rng: &mut R) -> Option<f64> {
+    if bound.is_nan() || bound >= NEE_RR_SCALE {
+        return Some(1.0);
+    }
+    if bound <= 0.0 {
+        return None; // the contribution is zero
+    }
+    let survive = bound / NEE_RR_SCALE;
+    if rng.gen::<f64>() < survive {
+        Some(1.0 / survive)
+    } else {
+        None
+    }
+}
+
+/// One draw of a rough exit face sampled from the target's `wo`.
+fn draw_exit(t: &Target, uc: f64, u: [f64; 2]) -> ExitDraw {
+    let none = ExitDraw {
+        w: DVec3::ZERO,
+        f: 0.0,
+        p2: 0.0,
+    };
+    let Exit::Rough(b) = t.exit else { return none };
+    match b.sample_mode(t.wo_l, uc, u, TransportMode::Radiance) {
+        Some(s) if s.wi.z < 0.0 && s.pdf > 0.0 && s.f.0[0] > 0.0 && s.f.0[0].is_finite() => ExitDraw {
+            w: -t.face.local(s.wi),
+            f: s.f.0[0],
+            p2: s.pdf,
+        },
+        _ => none,
+    }
+}
+
+/// `n` independent draws of a target's exit face (empty for a delta exit).
+fn draw_exits<R: Rng>(t: &Target, n: usize, rng: &mut R) -> Vec<ExitDraw> {
+    if !matches!(t.exit, Exit::Rough(_)) {
+        return Vec::new();
+    }
+    (0..n)
+        .map(|_| draw_exit(t, rng.gen(), [rng.gen(), rng.gen()]))
+        .collect()
+}
+
+/// Mean BSDF value of the transmitted draws (0 when there are none).
+fn f_scale(d: &[ExitDraw]) -> f64 {
+    let (s, n) = d
+        .iter()
+        .filter(|e| e.p2 > 0.0)
+        .fold((0.0, 0usize), |(s, n), e| (s + e.f, n + 1));
+    if n == 0 {
+        0.0
+    } else {
+        s / n as f64
+    }
+}
+
+/// The direction at cosine `cos` from unit `dir`, with a uniformly random
+/// azimuth. The azimuth's cosine and sine come from a point drawn uniformly in
+/// the unit disk by rejection, doubled in angle (`(x^2 - y^2, 2 x y) / r^2`),
+/// which avoids trigonometric functions; the distribution is exactly uniform.
+#[inline]
+fn direction_at<R: Rng>(dir: DVec3, cos: f64, rng: &mut R) -> DVec3 {
+    let (cp, sp) = loop {
+        let x = 2.0 * rng.gen::<f64>() - 1.0;
+        let y = 2.0 * rng.gen::<f64>() - 1.0;
+        let r2 = x * x + y * y;
+        if r2 <= 1.0 && r2 > 1e-12 {
+            break ((x * x - y * y) / r2, 2.0 * x * y / r2);
+        }
+    };
+    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+    let (t, b) = paperbsdf_core::geometry::coordinate_system(dir);
+    // Unit up to rounding (t, b, dir orthonormal); renormalise only if it drifts.
+    let w = sin * cp * t + sin * sp * b + cos * dir;
+    let l2 = w.length_squared();
+    if (l2 - 1.0).abs() > 1e-12 {
+        w / l2.sqrt()
+    } else {
+        w
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use paperbsdf_core::Distribution;
+    use rand::SeedableRng;
+
+    /// The estimator uses `eval_mode(a, b, Importance) = eval_mode(b, a, Radiance)`
+    /// (the adjoint BSDF, Veach 1997 section 5.2) to turn the exit face's
+    /// radiance BSDF sampled from `wo` into the flux it lets out toward `wo`.
+    #[test]
+    fn importance_eval_is_the_adjoint_of_radiance_eval() {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(1);
+        for (dist, eta, m) in [
+            (Distribution::Ggx, 1.45, 0.35),
+            (Distribution::Beckmann, 1.6, 0.1),
+            (Distribution::Ggx, 2.5, 0.9),
+        ] {
+            let b = RoughDielectric::new(dist, eta, m).unwrap();
+            let mut nonzero = 0;
+            for _ in 0..2000 {
+                let a = paperbsdf_core::geometry::sample_uniform_sphere([rng.gen(), rng.gen()]);
+                let c = paperbsdf_core::geometry::sample_uniform_sphere([rng.gen(), rng.gen()]);
+                let x = b.eval_mode(a, c, TransportMode::Importance);
+                let y = b.eval_mode(c, a, TransportMode::Radiance);
+                assert!((x - y).abs() <= 1e-12 * x.abs().max(1.0), "{a} {c}: {x} vs {y}");
+                nonzero += (x > 0.0) as usize;
+            }
+            assert!(nonzero > 100);
+        }
+    }
+
+    #[test]
+    fn nee_roulette_is_unbiased() {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(2);
+        for bound in [1e-5, 3e-4, 1.5e-3, 0.1] {
+            let n = 400_000;
+            let s: f64 = (0..n).map(|_| nee_roulette(bound, &mut rng).unwrap_or(0.0)).sum();
+            let mean = s / n as f64;
+            // Bernoulli(p) / p: relative standard error sqrt((1 - p) / (p n)).
+            let p = (bound / NEE_RR_SCALE).min(1.0);
+            let se = ((1.0 - p) / (p * n as f64)).sqrt();
+            assert!(
+                (mean - 1.0).abs() <= 4.0 * se + 1e-12,
+                "bound {bound}: {mean} (se {se})"
+            );
+        }
+        assert_eq!(nee_roulette(0.0, &mut rng), None);
+    }
+
+    #[test]
+    fn face_frames() {
+        let v = DVec3::new(0.3, -0.2, 0.9);
+        assert_eq!(Face::Front.local(v), v);
+        assert_eq!(Face::Back.local(Face::Back.local(v)), v);
+        assert!(Face::Back.local(v).z < 0.0);
+        assert_eq!(Face::toward(DVec3::new(0.0, 0.0, -1.0)), Face::Back);
+        assert_eq!(Face::Back.z(0.2), -0.2);
+    }
+
+    #[test]
+    fn direction_sampling_is_uniform_in_azimuth() {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(3);
+        let dir = DVec3::new(0.48, 0.6, 0.64);
+        let (t, b) = paperbsdf_core::geometry::coordinate_system(dir);
+        let n = 200_000;
+        let mut bins = [0usize; 8];
+        for _ in 0..n {
+            let w = direction_at(dir, 0.3, &mut rng);
+            assert!((w.length() - 1.0).abs() < 1e-12 && (w.dot(dir) - 0.3).abs() < 1e-12);
+            let phi = w.dot(b).atan2(w.dot(t)) + PI;
+            bins[((phi / (2.0 * PI) * 8.0) as usize).min(7)] += 1;
+        }
+        // Each bin: n/8 +- sqrt(n/8 * 7/8); allow 4 sigma.
+        let e = n as f64 / 8.0;
+        for c in bins {
+            assert!((c as f64 - e).abs() < 4.0 * (e * 7.0 / 8.0).sqrt(), "{bins:?}");
+        }
+    }
+}
