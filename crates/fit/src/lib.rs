@@ -1,1 +1,28 @@
-//! paperbsdf-fit (work in progress)
+//! # paperbsdf-fit
+//!
+//! Fitting BSDF models to in-plane (or general) BSDF measurements, as in
+//! sections 5 to 7 of the Paper BSDF supplement and DESIGN.md section 5:
+//!
+//! * [`measurement`]: readers for measurement files, with errors that name the
+//!   file, line and column;
+//! * [`model`]: what the fitter needs of a model ([`model::FitModel`]);
+//! * [`models`]: the Paper BSDF and the comparison models as fit models;
+//! * [`objective`]: the log-space RMS error and its weighting;
+//! * [`optimize`]: bounded Levenberg-Marquardt in the unit cube;
+//! * [`dataset`]: several files fitted together, thickness from headers;
+//! * [`fitter`]: global multi-start search plus local refinement, scoring of
+//!   fitted and extrapolation points.
+
+#![warn(missing_docs)]
+
+pub mod dataset;
+pub mod fitter;
+pub mod measurement;
+pub mod model;
+pub mod models;
+pub mod objective;
+pub mod optimize;
+
+pub use fitter::{fit, FitError, FitOptions, FitOutcome, GroupError};
+pub use measurement::{parse_measurement, read_measurement, Kind, Measurement, MeasurementError, Point};
+pub use model::{Evaluable, FitModel, ParamSpec, Scale, Subset};

@@ -1,0 +1,309 @@
+//! The models the fitter knows, as [`FitModel`]s: `paper` (the Paper BSDF,
+//! DESIGN.md section 4), `reduced-multilayer` (the Paper BSDF without the
+//! attenuation term, section 4.7) and `lambert-glass` (Lambertian reflection
+//! and transmission plus a rough dielectric, section 4.7).
+//!
+//! Search bounds (Table 2 of the supplement, made finite):
+//!
+//! | parameter | bounds | scale | default start |
+//! |---|---|---|---|
+//! | `sigma_a` (1/mm) | [1e-3, 100] | log | 0.5 |
+//! | `sigma_s` (1/mm) | [1, 3000] | log | 100 |
+//! | `g_f`, `g_b` | [-0.98, 0.98] | linear | 0.8, -0.3 |
+//! | `w_b` | [0, 1] | linear | 0.2 |
+//! | `eta_f`, `eta_b`, `eta` | [1.05, 3] | linear | 1.5 |
+//! | `m_f`, `m_b`, `m` | [0.01, pi/2] | log | 0.3 |
+//! | `k_d` | [0, 1] | linear | 0.5 |
+//! | `k_t / (1 - k_d)` | [0, 1] | linear | 0.5 |
+//!
+//! The index range is narrower than Table 2's (1, 5]: paper's cellulose, fillers
+//! and coatings have indices of 1.5 to 2, and a box that is mostly unphysical
+//! makes the global search slower. `d` is not fitted (the paper measured it). Index-matched (`eta = 1`) and
+//! smooth (`m = 0`) faces are not searched (DESIGN.md section 3). Each
+//! microfacet distribution choice (`ggx` or `beckmann`, per face) is a
+//! separate variant; the fitter tries every variant and keeps the best.
+//! With RGB data `sigma_a`, `sigma_s` (and `k_d`, `k_t`) are fitted per channel.
+//! The Lambert-glass model requires `k_d + k_t <= 1`; it is searched as `k_d`
+//! and the fraction `k_t / (1 - k_d)` of what is left, so that every point of
+//! the box is a valid model.
+
+use crate::model::{Evaluable, FitModel, ParamSpec, Scale};
+use paperbsdf_core::models::{ComponentModel, LambertGlass, LambertGlassParams};
+use paperbsdf_core::paper::{Component, PaperBsdf};
+use paperbsdf_core::{Bsdf, Colour, DVec3, Distribution, PaperParams, Rgb};
+
+/// Model names accepted by [`candidates`].
+pub const MODEL_NAMES: &[&str] = &["paper", "lambert-glass", "reduced-multilayer"];
+
+const DISTS: [Distribution; 2] = [Distribution::Ggx, Distribution::Beckmann];
+
+fn colour_specs(name: &str, lo: f64, hi: f64, scale: Scale, default: f64, rgb: bool) -> Vec<ParamSpec> {
+    if rgb {
+        (0..3)
+            .map(|c| ParamSpec::new(format!("{name}[{c}]"), lo, hi, scale, default))
+            .collect()
+    } else {
+        vec![ParamSpec::new(name, lo, hi, scale, default)]
+    }
+}
+
+fn colour_of(x: &[f64], rgb: bool) -> Colour {
+    if rgb {
+        Colour::Rgb([x[0], x[1], x[2]])
+    } else {
+        Colour::Scalar(x[0])
+    }
+}
+
+fn colour_json(c: &Colour) -> serde_json::Value {
+    serde_json::to_value(c).expect("colour serialises")
+}
+
+/// The Paper BSDF (or its reduced multilayer variant) with fixed thickness and distributions.
+pub struct PaperFit {
+    d: f64,
+    dist_f: Distribution,
+    dist_b: Distribution,
+    rgb: bool,
+    reduced: bool,
+    specs: Vec<ParamSpec>,
+}
+
+impl PaperFit {
+    /// A variant: thickness `d` (mm), the two distributions, RGB or scalar
+    /// coefficients, and whether it is the reduced multilayer model.
+    pub fn new(d: f64, dist_f: Distribution, dist_b: Distribution, rgb: bool, reduced: bool) -> Self {
+        let mut specs = colour_specs("sigma_a", 1e-3, 100.0, Scale::Log, 0.5, rgb);
+        specs.extend(colour_specs("sigma_s", 1.0, 3000.0, Scale::Log, 100.0, rgb));
+        let pi2 = std::f64::consts::FRAC_PI_2;
+        specs.extend([
+            ParamSpec::new("g_f", -0.98, 0.98, Scale::Linear, 0.8),
+            ParamSpec::new("g_b", -0.98, 0.98, Scale::Linear, -0.3),
+            ParamSpec::new("w_b", 0.0, 1.0, Scale::Linear, 0.2),
+            ParamSpec::new("eta_f", 1.05, 3.0, Scale::Linear, 1.5),
+            ParamSpec::new("eta_b", 1.05, 3.0, Scale::Linear, 1.5),
+            ParamSpec::new("m_f", 0.01, pi2, Scale::Log, 0.3),
+            ParamSpec::new("m_b", 0.01, pi2, Scale::Log, 0.3),
+        ]);
+        PaperFit {
+            d,
+            dist_f,
+            dist_b,
+            rgb,
+            reduced,
+            specs,
+        }
+    }
+
+    /// The parameter set of values `x`.
+    pub fn params(&self, x: &[f64]) -> PaperParams {
+        let nc = if self.rgb { 3 } else { 1 };
+        let r = &x[2 * nc..];
+        PaperParams {
+            name: None,
+            d: self.d,
+            sigma_a: colour_of(&x[..nc], self.rgb),
+            sigma_s: colour_of(&x[nc..2 * nc], self.rgb),
+            g_f: r[0],
+            g_b: r[1],
+            w_b: r[2],
+            eta_f: r[3],
+            eta_b: r[4],
+            m_f: r[5],
+            m_b: r[6],
+            dist_f: self.dist_f,
+            dist_b: self.dist_b,
+        }
+    }
+}
+
+/// A built Paper BSDF as an [`Evaluable`] with its four components.
+pub struct PaperEval(pub PaperBsdf);
+
+const PAPER_COMPONENTS: [Component; 4] = [
+    Component::Surface,
+    Component::Single,
+    Component::Multiple,
+    Component::Direct,
+];
+
+impl Evaluable for PaperEval {
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
+        self.0.eval(wi, wo)
+    }
+    fn component_names(&self) -> Vec<&'static str> {
+        vec!["surface", "single", "multiple", "direct"]
+    }
+    fn eval_component(&self, index: usize, wi: DVec3, wo: DVec3) -> Rgb {
+        self.0.eval_component(wi, wo, PAPER_COMPONENTS[index])
+    }
+}
+
+/// Builds the Paper BSDF (or the reduced multilayer model) from a parameter set.
+pub fn build_paper(p: &PaperParams, reduced: bool) -> Result<PaperEval, String> {
+    let b = if reduced {
+        PaperBsdf::reduced_multilayer(p)
+    } else {
+        PaperBsdf::new(p)
+    };
+    b.map(PaperEval).map_err(|e| e.to_string())
+}
+
+impl FitModel for PaperFit {
+    fn model_name(&self) -> &str {
+        if self.reduced {
+            "reduced-multilayer"
+        } else {
+            "paper"
+        }
+    }
+    fn variant(&self) -> String {
+        format!("dist_f={}, dist_b={}", self.dist_f.name(), self.dist_b.name())
+    }
+    fn specs(&self) -> &[ParamSpec] {
+        &self.specs
+    }
+    fn build(&self, x: &[f64]) -> Result<Box<dyn Evaluable>, String> {
+        Ok(Box::new(build_paper(&self.params(x), self.reduced)?))
+    }
+    fn params_json(&self, x: &[f64]) -> serde_json::Value {
+        let p = self.params(x);
+        serde_json::json!({
+            "d": p.d, "sigma_a": colour_json(&p.sigma_a), "sigma_s": colour_json(&p.sigma_s),
+            "g_f": p.g_f, "g_b": p.g_b, "w_b": p.w_b, "eta_f": p.eta_f, "eta_b": p.eta_b,
+            "m_f": p.m_f, "m_b": p.m_b, "dist_f": p.dist_f.name(), "dist_b": p.dist_b.name(),
+        })
+    }
+}
+
+/// The Lambert + rough glass baseline with a fixed distribution.
+pub struct LambertGlassFit {
+    dist: Distribution,
+    rgb: bool,
+    specs: Vec<ParamSpec>,
+}
+
+impl LambertGlassFit {
+    /// A variant with distribution `dist`, RGB or scalar Lambert weights.
+    pub fn new(dist: Distribution, rgb: bool) -> Self {
+        let mut specs = colour_specs("k_d", 0.0, 1.0, Scale::Linear, 0.5, rgb);
+        specs.extend(colour_specs("k_t/(1-k_d)", 0.0, 1.0, Scale::Linear, 0.5, rgb));
+        specs.push(ParamSpec::new("eta", 1.05, 3.0, Scale::Linear, 1.5));
+        specs.push(ParamSpec::new("m", 0.01, std::f64::consts::FRAC_PI_2, Scale::Log, 0.3));
+        LambertGlassFit { dist, rgb, specs }
+    }
+    /// The parameter set of values `x`.
+    pub fn params(&self, x: &[f64]) -> LambertGlassParams {
+        let nc = if self.rgb { 3 } else { 1 };
+        let kt: Vec<f64> = (0..nc).map(|c| x[nc + c] * (1.0 - x[c])).collect();
+        LambertGlassParams {
+            name: None,
+            k_d: colour_of(&x[..nc], self.rgb),
+            k_t: colour_of(&kt, self.rgb),
+            eta: x[2 * nc],
+            m: x[2 * nc + 1],
+            dist: self.dist,
+        }
+    }
+}
+
+/// A built Lambert + rough glass model with components `lambert` and `rough glass`.
+pub struct LambertGlassEval(pub LambertGlass);
+
+impl Evaluable for LambertGlassEval {
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
+        self.0.eval(wi, wo)
+    }
+    fn component_names(&self) -> Vec<&'static str> {
+        vec!["lambert", "rough glass"]
+    }
+    fn eval_component(&self, index: usize, wi: DVec3, wo: DVec3) -> Rgb {
+        // The Lambertian terms are the model's `Multiple` component; the glass is
+        // its surface reflection and its clear (direct) transmission.
+        if index == 0 {
+            self.0.eval_component(wi, wo, Component::Multiple)
+        } else {
+            self.0.eval_component(wi, wo, Component::Surface) + self.0.eval_component(wi, wo, Component::Direct)
+        }
+    }
+}
+
+impl FitModel for LambertGlassFit {
+    fn model_name(&self) -> &str {
+        "lambert-glass"
+    }
+    fn variant(&self) -> String {
+        format!("dist={}", self.dist.name())
+    }
+    fn specs(&self) -> &[ParamSpec] {
+        &self.specs
+    }
+    fn build(&self, x: &[f64]) -> Result<Box<dyn Evaluable>, String> {
+        LambertGlass::new(&self.params(x))
+            .map(|b| Box::new(LambertGlassEval(b)) as Box<dyn Evaluable>)
+            .map_err(|e| e.to_string())
+    }
+    fn params_json(&self, x: &[f64]) -> serde_json::Value {
+        let p = self.params(x);
+        serde_json::json!({"k_d": colour_json(&p.k_d), "k_t": colour_json(&p.k_t), "eta": p.eta, "m": p.m, "dist": p.dist.name()})
+    }
+}
+
+/// The variants of model `name` to search: for the paper models every pair of
+/// distributions (thickness `d` required), for lambert-glass both distributions.
+/// `dists` restricts the distributions tried (default: both).
+pub fn candidates(
+    name: &str,
+    d: Option<f64>,
+    rgb: bool,
+    dists: Option<&[Distribution]>,
+) -> Result<Vec<Box<dyn FitModel>>, String> {
+    let ds: Vec<Distribution> = dists.map(|d| d.to_vec()).unwrap_or_else(|| DISTS.to_vec());
+    match name {
+        "paper" | "reduced-multilayer" => {
+            let d = d.ok_or_else(|| {
+                format!("model `{name}` needs the paper's thickness d: pass --thickness D (mm) or give the data a `# thickness: D` or `# params: {{\"d\": D, ...}}` header")
+            })?;
+            if !(d > 0.0 && d.is_finite()) {
+                return Err(format!("thickness d = {d} is outside its allowed range (0, inf) mm"));
+            }
+            let mut v: Vec<Box<dyn FitModel>> = Vec::new();
+            for &f in &ds {
+                for &b in &ds {
+                    v.push(Box::new(PaperFit::new(d, f, b, rgb, name == "reduced-multilayer")));
+                }
+            }
+            Ok(v)
+        }
+        "lambert-glass" => Ok(ds
+            .iter()
+            .map(|&dd| Box::new(LambertGlassFit::new(dd, rgb)) as Box<dyn FitModel>)
+            .collect()),
+        _ => Err(format!(
+            "unknown model `{name}`; known models: {}",
+            MODEL_NAMES.join(", ")
+        )),
+    }
+}
+
+/// Builds model `name` from a parameter set (the `params` of a FIT.json).
+pub fn build_from_params(name: &str, params: &serde_json::Value) -> Result<Box<dyn Evaluable>, String> {
+    match name {
+        "paper" | "reduced-multilayer" => {
+            let p: PaperParams =
+                serde_json::from_value(params.clone()).map_err(|e| format!("params of `{name}`: {e}"))?;
+            Ok(Box::new(build_paper(&p, name == "reduced-multilayer")?))
+        }
+        "lambert-glass" => {
+            let p: LambertGlassParams =
+                serde_json::from_value(params.clone()).map_err(|e| format!("params of `{name}`: {e}"))?;
+            Ok(Box::new(LambertGlassEval(
+                LambertGlass::new(&p).map_err(|e| e.to_string())?,
+            )))
+        }
+        _ => Err(format!(
+            "unknown model `{name}`; known models: {}",
+            MODEL_NAMES.join(", ")
+        )),
+    }
+}

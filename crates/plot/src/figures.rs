@@ -1,0 +1,216 @@
+//! The analogues of the supplement's Figures 3, 4 and 5 and the table of fit
+//! errors: every bundled paper (`matte`, `luster`, `glossy` in the data
+//! directory) and every reference set (`reference/*.csv`) is fitted with each
+//! of the three models (`paper`, `lambert-glass`, `reduced-multilayer`) on the
+//! incident angles of [`DEFAULT_FIT_THETA_I`]; the other angles are
+//! extrapolation (grey panels). One figure per model, one row per paper.
+
+use crate::{draw_figure, panels_for, Figure, Row};
+use paperbsdf_fit::dataset::load_dataset;
+use paperbsdf_fit::models::candidates;
+use paperbsdf_fit::{fit, FitOptions, FitOutcome};
+use std::path::{Path, PathBuf};
+
+/// Incident angles fitted by default (those a data set has); the others are extrapolation.
+pub const DEFAULT_FIT_THETA_I: [f64; 3] = [0.0, 30.0, 60.0];
+
+/// The bundled papers, in figure row order.
+pub const PAPERS: [&str; 3] = ["matte", "luster", "glossy"];
+
+/// The figures: (number, model, file stem, title).
+pub const FIGURES: [(u32, &str, &str, &str); 3] = [
+    (
+        3,
+        "paper",
+        "fig3_paper",
+        "Paper BSDF fits (analogue of supplement Figure 3)",
+    ),
+    (
+        4,
+        "lambert-glass",
+        "fig4_lambert_glass",
+        "Lambertian + rough glass fits (analogue of supplement Figure 4)",
+    ),
+    (
+        5,
+        "reduced-multilayer",
+        "fig5_reduced_multilayer",
+        "Reduced multilayer BSDF fits (analogue of supplement Figure 5)",
+    ),
+];
+
+/// Settings of [`make_figures`].
+#[derive(Clone, Debug)]
+pub struct FiguresOptions {
+    /// Directory with `matte.csv`, `luster.csv`, `glossy.csv` and optionally `reference/*.csv`.
+    pub data_dir: PathBuf,
+    /// Output directory for the figures and `fit_table.md`.
+    pub out_dir: PathBuf,
+    /// Fitted incident angles.
+    pub fit_theta_i: Vec<f64>,
+    /// Fit settings (the `fit_theta_i` inside is replaced per data set).
+    pub fit: FitOptions,
+}
+
+/// One fit of the table.
+#[derive(Clone, Debug)]
+pub struct TableRow {
+    /// Data set name.
+    pub data: String,
+    /// The fit.
+    pub outcome: FitOutcome,
+}
+
+fn data_sets(dir: &Path) -> Result<Vec<(String, String, bool)>, String> {
+    let mut v = Vec::new();
+    for p in PAPERS {
+        let f = dir.join(format!("{p}.csv"));
+        if !f.exists() {
+            return Err(format!("{}: missing (the bundled {p} paper measurement)", f.display()));
+        }
+        v.push((p.to_string(), f.display().to_string(), true));
+    }
+    let rd = dir.join("reference");
+    if let Ok(rd) = std::fs::read_dir(&rd) {
+        let mut refs: Vec<PathBuf> = rd
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|e| e == "csv"))
+            .collect();
+        refs.sort();
+        for r in refs {
+            let name = r.file_stem().unwrap().to_string_lossy().to_string();
+            v.push((name, r.display().to_string(), false));
+        }
+    }
+    Ok(v)
+}
+
+/// Fits every data set with every model, draws the three figures (PNG and SVG,
+/// linear value axis, plus a PNG with a log axis) and writes `fit_table.md`.
+/// Returns the table rows.
+pub fn make_figures(opts: &FiguresOptions) -> Result<Vec<TableRow>, String> {
+    let sets = data_sets(&opts.data_dir)?;
+    std::fs::create_dir_all(&opts.out_dir).map_err(|e| format!("{}: {e}", opts.out_dir.display()))?;
+    let mut table = Vec::new();
+    for (num, model, stem, title) in FIGURES {
+        let mut rows = Vec::new();
+        for (name, path, in_figure) in &sets {
+            let ds = load_dataset(std::slice::from_ref(path), None)?;
+            let present: Vec<f64> = opts
+                .fit_theta_i
+                .iter()
+                .cloned()
+                .filter(|t| ds.points.iter().any(|p| (p.theta_i - t).abs() < 1e-6))
+                .collect();
+            let cands = candidates(model, ds.thickness, ds.channels == 3, None)?;
+            let fo = FitOptions {
+                fit_theta_i: Some(present.clone()),
+                ..opts.fit.clone()
+            };
+            let out = fit(&ds.points, ds.channels, &cands, &fo).map_err(|e| format!("{name}, {model}: {e}"))?;
+            eprintln!(
+                "figure {num}: {name:>8} {model:>18}: rms {:.4}, extrapolation {:.4}, {:.2} s ({})",
+                out.rms_log_error,
+                out.extrapolation_rms_log_error.unwrap_or(f64::NAN),
+                out.seconds,
+                out.variant
+            );
+            if *in_figure {
+                let m = cands[out.variant_index].build(&out.x)?;
+                rows.push(Row {
+                    label: name.clone(),
+                    panels: panels_for(&ds.points, Some(m.as_ref()), Some(&present)),
+                });
+            }
+            table.push(TableRow {
+                data: name.clone(),
+                outcome: out,
+            });
+        }
+        let mut fig = Figure {
+            title: format!("{title}; grey: extrapolated incident angles"),
+            rows,
+            log_y: false,
+        };
+        for ext in ["png", "svg"] {
+            draw_figure(&fig, &opts.out_dir.join(format!("{stem}.{ext}"))).map_err(|e| e.to_string())?;
+        }
+        fig.log_y = true;
+        draw_figure(&fig, &opts.out_dir.join(format!("{stem}_log.png"))).map_err(|e| e.to_string())?;
+    }
+    let md = table_markdown(&table, opts);
+    paperbsdf_io::write_atomic(opts.out_dir.join("fit_table.md"), md.as_bytes()).map_err(|e| e.to_string())?;
+    Ok(table)
+}
+
+fn fmt_opt(v: Option<f64>) -> String {
+    v.map(|e| format!("{e:.4}")).unwrap_or_else(|| "-".into())
+}
+
+/// The Markdown table of fit errors (and the fitted parameters).
+pub fn table_markdown(rows: &[TableRow], opts: &FiguresOptions) -> String {
+    let mut s = String::from("# Fit errors\n\n");
+    s += &format!(
+        "Written by `paperbsdf plot --figures --data-dir {} --out {}` (seconds: wall-clock time of each fit). Each data set is fitted on the incident angles {:?} (those it has); \
+         the remaining angles are extrapolation. Error: weighted RMS of ln((f_model + e)/(f_meas + e)), e = {}, \
+         weights 1/max(stderr/(f_meas + e), {})^2 (crates/fit/src/objective.rs). The bundled sets are simulated \
+         (data/README.md); `devA`, `devB` are the independent brute-force references (Mitsuba 3).\n\n",
+        opts.data_dir.display(),
+        opts.out_dir.display(),
+        opts.fit_theta_i,
+        paperbsdf_fit::objective::LOG_OFFSET,
+        paperbsdf_fit::objective::SIGMA_FLOOR
+    );
+    s += "| data | model | fitted RMS log error | extrapolation RMS log error | fitted / extrap. points | seconds | distributions |\n";
+    s += "|---|---|---|---|---|---|---|\n";
+    let mut names: Vec<&str> = rows.iter().map(|r| r.data.as_str()).collect();
+    names.dedup();
+    let mut order: Vec<&str> = Vec::new();
+    for n in names {
+        if !order.contains(&n) {
+            order.push(n);
+        }
+    }
+    for n in &order {
+        for r in rows.iter().filter(|r| r.data == *n) {
+            let o = &r.outcome;
+            s += &format!(
+                "| {} | {} | {:.4} | {} | {} / {} | {:.2} | {} |\n",
+                r.data,
+                o.model,
+                o.rms_log_error,
+                fmt_opt(o.extrapolation_rms_log_error),
+                o.counts.0,
+                o.counts.1,
+                o.seconds,
+                o.variant
+            );
+        }
+    }
+    s +=
+        "\n## Does the Paper BSDF win?\n\n| data | lowest fitted error | lowest extrapolation error |\n|---|---|---|\n";
+    for n in &order {
+        let rs: Vec<&TableRow> = rows.iter().filter(|r| r.data == *n).collect();
+        let best_fit = rs
+            .iter()
+            .min_by(|a, b| a.outcome.rms_log_error.total_cmp(&b.outcome.rms_log_error))
+            .unwrap();
+        let best_ex = rs
+            .iter()
+            .filter(|r| r.outcome.extrapolation_rms_log_error.is_some())
+            .min_by(|a, b| {
+                a.outcome
+                    .extrapolation_rms_log_error
+                    .unwrap()
+                    .total_cmp(&b.outcome.extrapolation_rms_log_error.unwrap())
+            })
+            .map(|r| r.outcome.model.as_str())
+            .unwrap_or("-");
+        s += &format!("| {n} | {} | {best_ex} |\n", best_fit.outcome.model);
+    }
+    s += "\n## Fitted parameters\n\n";
+    for r in rows {
+        s += &format!("- {} / {}: `{}`\n", r.data, r.outcome.model, r.outcome.params);
+    }
+    s
+}
