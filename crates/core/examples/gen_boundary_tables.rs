@@ -6,12 +6,28 @@ use paperbsdf_core::{Distribution, RoughDielectric};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 fn main() {
-    let dists = [Distribution::Ggx, Distribution::Beckmann];
+    // PAPERBSDF_TABLE_ONLY=ggx|beckmann recomputes one distribution and keeps the
+    // other's values from the existing table file.
+    let only = std::env::var("PAPERBSDF_TABLE_ONLY")
+        .ok()
+        .and_then(|s| Distribution::parse(&s));
+    let dists: Vec<Distribution> = [Distribution::Ggx, Distribution::Beckmann]
+        .into_iter()
+        .filter(|d| only.is_none_or(|o| o == *d))
+        .collect();
     let jobs: Vec<(Distribution, usize, usize)> = dists
         .iter()
         .flat_map(|&d| (0..N_ETA).flat_map(move |i| (0..N_M).map(move |j| (d, i, j))))
         .collect();
-    let out = std::sync::Mutex::new(vec![0f32; TABLE_LEN]);
+    let mut init = vec![0f32; TABLE_LEN];
+    if only.is_some() {
+        let existing = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/data/boundary_tables.bin")).unwrap();
+        assert_eq!(existing.len(), 4 * TABLE_LEN, "existing table has another layout");
+        for (v, c) in init.iter_mut().zip(existing.chunks_exact(4)) {
+            *v = f32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+        }
+    }
+    let out = std::sync::Mutex::new(init);
     let next = AtomicUsize::new(0);
     let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(2);
     std::thread::scope(|sc| {
@@ -29,7 +45,7 @@ fn main() {
                 let v = encode_node(&s);
                 let o = node_offset(d, i, j);
                 out.lock().unwrap()[o..o + NODE_LEN].copy_from_slice(&v);
-                if k % 50 == 0 {
+                if k.is_multiple_of(50) {
                     eprintln!("{k}/{}", jobs.len());
                 }
             });

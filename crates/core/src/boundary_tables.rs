@@ -18,11 +18,11 @@ use crate::microfacet::Distribution;
 use std::sync::OnceLock;
 
 /// Nodes in eta.
-pub const N_ETA: usize = 33;
+pub const N_ETA: usize = 49;
 /// Nodes in m.
-pub const N_M: usize = 33;
+pub const N_M: usize = 49;
 /// Quadrature points per axis used to generate the tables.
-pub const TABLE_QUADRATURE_POINTS: usize = 192;
+pub const TABLE_QUADRATURE_POINTS: usize = 160;
 /// Number of f32 values per node: four mu curves and two scalars.
 pub const NODE_LEN: usize = 4 * N_MU + 2;
 /// Number of f32 values in the table file.

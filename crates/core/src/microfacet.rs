@@ -227,7 +227,8 @@ pub struct BeckmannVisibleFrame {
 impl BeckmannVisibleFrame {
     fn new(alpha: f64, w: DVec3) -> Self {
         let wi = DVec3::new(alpha * w.x, alpha * w.y, w.z).normalize();
-        let sin_t = (1.0 - wi.z * wi.z).max(0.0).sqrt();
+        // From x and y, not sqrt(1 - z^2), which cancels near normal incidence.
+        let sin_t = wi.x.hypot(wi.y);
         let (cos_phi, sin_phi) = if sin_t > 1e-12 {
             (wi.x / sin_t, wi.y / sin_t)
         } else {

@@ -54,7 +54,13 @@ const NA: usize = 65;
 
 #[inline]
 fn lerp_t(tab: &[f64; NA], mu: f64) -> f64 {
-    let x = mu.abs().min(1.0).sqrt() * (NA - 1) as f64;
+    lerp_sqrt(tab, mu.abs().min(1.0).sqrt())
+}
+
+/// [`lerp_t`] at `mu = st^2` for a precomputed `st = sqrt(min(|mu|, 1))`.
+#[inline]
+fn lerp_sqrt(tab: &[f64; NA], st: f64) -> f64 {
+    let x = st * (NA - 1) as f64;
     let i = (x as usize).min(NA - 2);
     let f = x - i as f64;
     tab[i] * (1.0 - f) + tab[i + 1] * f
@@ -95,10 +101,11 @@ impl Face {
         }
         if use_att {
             // mu = t^2 concentrates nodes near grazing where Att changes fastest.
-            let (x, w) = gauss_legendre_01(24);
+            static GL: std::sync::OnceLock<(Vec<f64>, Vec<f64>)> = std::sync::OnceLock::new();
+            let (x, w) = GL.get_or_init(|| gauss_legendre_01(24));
             f.abar = x
                 .iter()
-                .zip(&w)
+                .zip(w)
                 .map(|(t, wt)| 2.0 * wt * f.att(t * t) * t * t * 2.0 * t)
                 .sum();
         }
@@ -121,6 +128,30 @@ impl Face {
             Interface::IndexMatched => 1.0,
             Interface::Smooth => 1.0 - fresnel_dielectric(mu.abs(), self.bd.eta),
             Interface::Rough(_) => lerp_t(&self.att_tab, mu),
+        }
+    }
+
+    /// [`Face::att`] at `mu` given also `st = sqrt(min(|mu|, 1))` (saves the
+    /// square root when the caller has it already).
+    #[inline]
+    pub fn att_with_sqrt(&self, mu: f64, st: f64) -> f64 {
+        if !self.use_att {
+            return 1.0;
+        }
+        match self.bd.interface {
+            Interface::IndexMatched => 1.0,
+            Interface::Smooth => 1.0 - fresnel_dielectric(mu.abs(), self.bd.eta),
+            Interface::Rough(_) => lerp_sqrt(&self.att_tab, st),
+        }
+    }
+
+    /// [`Face::r_out`] given also `st = sqrt(min(|mu|, 1))`.
+    #[inline]
+    pub fn r_out_with_sqrt(&self, mu: f64, st: f64) -> f64 {
+        match self.bd.interface {
+            Interface::IndexMatched => 0.0,
+            Interface::Smooth => fresnel_dielectric(mu.abs(), self.bd.eta),
+            Interface::Rough(_) => lerp_sqrt(&self.r_tab, st),
         }
     }
 
@@ -197,6 +228,36 @@ impl Face {
             return 0.0;
         }
         mf.pdf_visible(wo, h) / (4.0 * oh)
+    }
+
+    /// `(f_r, pdf)`: [`Face::reflection`] and [`Face::reflection_pdf`] at once,
+    /// sharing the half vector and `D(h)` (for `sample`, which needs both).
+    #[inline]
+    pub fn reflection_and_pdf(&self, wi: DVec3, wo: DVec3) -> (f64, f64) {
+        let Interface::Rough(mf) = self.bd.interface else {
+            return (0.0, 0.0);
+        };
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let h = wi + wo;
+        let hl = h.length();
+        if hl == 0.0 || !hl.is_finite() {
+            return (0.0, 0.0);
+        }
+        let h = h / hl;
+        let d = mf.d(h);
+        if d == 0.0 {
+            return (0.0, 0.0);
+        }
+        let oh = wo.dot(h);
+        let f = fresnel_dielectric(oh, self.bd.eta) * d * mf.g(wo, wi, h) / (4.0 * wo.z * wi.z);
+        let pdf = if oh > 0.0 {
+            mf.g1_exact(wo, h) * d / (4.0 * wo.z)
+        } else {
+            0.0
+        };
+        (f, pdf)
     }
 
     /// Draws a reflected `wi` (face frame) from the visible normals seen from `wo`.
