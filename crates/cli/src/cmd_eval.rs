@@ -61,7 +61,7 @@ pub fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
             .with_context(|| format!("{what} `{s}`: `{p}` is not a number"))
     };
     let (from, to, step) = (num(parts[0])?, num(parts[1])?, num(parts[2])?);
-    if !(step > 0.0) || !from.is_finite() || !to.is_finite() {
+    if step.is_nan() || step <= 0.0 || !from.is_finite() || !to.is_finite() {
         bail!("{what} `{s}`: STEP must be positive and FROM, TO finite");
     }
     let n = ((to - from) / step + 1e-9).floor();

@@ -1,0 +1,187 @@
+//! Textures: colours (constant, checkerboard, image) and greyscale maps
+//! (constant, checkerboard, image) looked up by surface coordinates `(u, v)`.
+//!
+//! Image textures are bilinearly filtered and repeat outside [0, 1]. `v = 0` is
+//! the bottom row of the image, as in OBJ files, pbrt and Mitsuba. Colour images
+//! are decoded from sRGB to linear; greyscale maps (masks, thickness and ink
+//! maps) are used as stored, 0 = black, 1 = white, with no gamma.
+
+use paperbsdf_core::Rgb;
+use std::path::Path;
+use std::sync::Arc;
+
+/// A decoded image: `channels` floats per pixel, rows from the top.
+#[derive(Debug)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// 3 (linear RGB) or 1 (grey).
+    pub channels: usize,
+    /// Pixel values, row-major, top row first.
+    pub data: Vec<f32>,
+}
+
+fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+impl Image {
+    /// Decodes an image file (PNG) as linear RGB (`grey = false`, sRGB decoded)
+    /// or as a greyscale map (`grey = true`, values as stored).
+    pub fn load(path: &Path, grey: bool) -> Result<Image, String> {
+        let img = image::open(path).map_err(|e| format!("cannot read image '{}': {e}", path.display()))?;
+        Ok(Self::from_dynamic(img, grey))
+    }
+    /// Decodes an image held in memory (built-in scenes embed their masks).
+    pub fn from_bytes(bytes: &[u8], grey: bool) -> Result<Image, String> {
+        let img = image::load_from_memory(bytes).map_err(|e| format!("cannot decode embedded image: {e}"))?;
+        Ok(Self::from_dynamic(img, grey))
+    }
+    fn from_dynamic(img: image::DynamicImage, grey: bool) -> Image {
+        let (width, height) = (img.width() as usize, img.height() as usize);
+        if grey {
+            let g = img.to_luma32f();
+            Image {
+                width,
+                height,
+                channels: 1,
+                data: g.into_raw(),
+            }
+        } else {
+            let c = img.to_rgb32f();
+            let data = c.into_raw().into_iter().map(srgb_to_linear).collect();
+            Image {
+                width,
+                height,
+                channels: 3,
+                data,
+            }
+        }
+    }
+    /// Bilinear lookup of channel `c` at `(u, v)`, repeating.
+    fn bilinear(&self, u: f64, v: f64, c: usize) -> f64 {
+        let x = u.rem_euclid(1.0) * self.width as f64 - 0.5;
+        let y = (1.0 - v.rem_euclid(1.0)) * self.height as f64 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let px = |xi: i64, yi: i64| -> f64 {
+            let xi = xi.rem_euclid(self.width as i64) as usize;
+            let yi = yi.rem_euclid(self.height as i64) as usize;
+            self.data[(yi * self.width + xi) * self.channels + c] as f64
+        };
+        let (xi, yi) = (x0 as i64, y0 as i64);
+        (1.0 - fy) * ((1.0 - fx) * px(xi, yi) + fx * px(xi + 1, yi))
+            + fy * ((1.0 - fx) * px(xi, yi + 1) + fx * px(xi + 1, yi + 1))
+    }
+}
+
+/// Whether `(u, v)` falls on an even square of a checkerboard with `scale` squares per unit of `u` and `v`.
+fn checker_even(u: f64, v: f64, scale: f64) -> bool {
+    let (i, j) = ((u * scale).floor() as i64, (v * scale).floor() as i64);
+    (i + j).rem_euclid(2) == 0
+}
+
+/// A colour that may vary over a surface.
+#[derive(Clone, Debug)]
+pub enum ColourTexture {
+    /// The same colour everywhere.
+    Constant(Rgb),
+    /// Alternating squares; `scale` squares per unit of `u` and `v`.
+    Checker {
+        /// Colour of squares with even `floor(u s) + floor(v s)`.
+        even: Rgb,
+        /// Colour of the other squares.
+        odd: Rgb,
+        /// Squares per unit of `u` and `v`.
+        scale: f64,
+    },
+    /// An image (linear RGB), scaled by `scale` squares per unit... repeats `scale` times.
+    Image {
+        /// The image.
+        image: Arc<Image>,
+        /// Repetitions per unit of `u` and `v`.
+        scale: f64,
+    },
+}
+
+impl ColourTexture {
+    /// The colour at `(u, v)`.
+    pub fn eval(&self, u: f64, v: f64) -> Rgb {
+        match self {
+            ColourTexture::Constant(c) => *c,
+            ColourTexture::Checker { even, odd, scale } => {
+                if checker_even(u, v, *scale) {
+                    *even
+                } else {
+                    *odd
+                }
+            }
+            ColourTexture::Image { image, scale } => {
+                let (u, v) = (u * scale, v * scale);
+                if image.channels == 3 {
+                    Rgb::new(
+                        image.bilinear(u, v, 0),
+                        image.bilinear(u, v, 1),
+                        image.bilinear(u, v, 2),
+                    )
+                } else {
+                    Rgb::splat(image.bilinear(u, v, 0))
+                }
+            }
+        }
+    }
+    /// The largest channel value anywhere (for checks such as albedo <= 1).
+    pub fn max_value(&self) -> f64 {
+        match self {
+            ColourTexture::Constant(c) => c.max_channel(),
+            ColourTexture::Checker { even, odd, .. } => even.max_channel().max(odd.max_channel()),
+            ColourTexture::Image { image, .. } => image.data.iter().fold(0.0f64, |m, &x| m.max(x as f64)),
+        }
+    }
+}
+
+/// A greyscale value in [0, 1] that may vary over a surface (masks, thickness and ink maps).
+#[derive(Clone, Debug)]
+pub enum GreyTexture {
+    /// The same value everywhere.
+    Constant(f64),
+    /// Alternating squares.
+    Checker {
+        /// Value of even squares.
+        even: f64,
+        /// Value of odd squares.
+        odd: f64,
+        /// Squares per unit of `u` and `v`.
+        scale: f64,
+    },
+    /// An image read as grey, values as stored.
+    Image {
+        /// The image.
+        image: Arc<Image>,
+        /// Repetitions per unit of `u` and `v`.
+        scale: f64,
+    },
+}
+
+impl GreyTexture {
+    /// The value at `(u, v)`.
+    pub fn eval(&self, u: f64, v: f64) -> f64 {
+        match self {
+            GreyTexture::Constant(c) => *c,
+            GreyTexture::Checker { even, odd, scale } => {
+                if checker_even(u, v, *scale) {
+                    *even
+                } else {
+                    *odd
+                }
+            }
+            GreyTexture::Image { image, scale } => image.bilinear(u * scale, v * scale, 0),
+        }
+    }
+}
