@@ -61,31 +61,6 @@ fn load(source: &str) -> Result<PaperParams> {
     Ok(l.value)
 }
 
-/// Parses `FROM:TO:STEP` (degrees) into the list of angles, TO included when hit.
-fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
-    let parts: Vec<&str> = s.split(':').collect();
-    if parts.len() != 3 {
-        bail!("{what} `{s}`: expected FROM:TO:STEP in degrees, e.g. -80:80:10");
-    }
-    let num = |p: &str| {
-        p.trim()
-            .parse::<f64>()
-            .with_context(|| format!("{what} `{s}`: `{p}` is not a number"))
-    };
-    let (from, to, step) = (num(parts[0])?, num(parts[1])?, num(parts[2])?);
-    if !(step > 0.0 && from.is_finite() && to.is_finite()) {
-        bail!("{what} `{s}`: STEP must be positive and FROM, TO finite");
-    }
-    let n = ((to - from) / step + 1e-9).floor();
-    if n < 0.0 {
-        bail!("{what} `{s}`: TO is below FROM");
-    }
-    if n > 10_000.0 {
-        bail!("{what} `{s}`: more than 10000 angles");
-    }
-    Ok((0..=n as usize).map(|k| from + k as f64 * step).collect())
-}
-
 /// Checks that every angle is finite and within `(lo, hi)` (open) or `[lo, hi)`.
 fn check_angles(v: &[f64], what: &str, lo: f64, lo_inclusive: bool, hi: f64) -> Result<()> {
     for &a in v {
@@ -204,7 +179,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         if a.theta_i.is_empty() {
             bail!("--theta-o needs --theta-i LIST (degrees)");
         }
-        let to = parse_range(range, "--theta-o")?;
+        let to = crate::cmd_eval::parse_range(range, "--theta-o")?;
         check_angles(&a.theta_i, "--theta-i", 0.0, true, 90.0)?;
         check_angles(&to, "--theta-o", -90.0, false, 90.0)?;
         let cols = if rgb {
