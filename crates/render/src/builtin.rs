@@ -3,10 +3,11 @@
 //! the images they use, so they render from anywhere.
 //!
 //! - `scene_ref`: the scene Mitsuba 3 rendered for `reference/scene_ref.exr`.
-//! - `checkerboard`: matte, glossy and lustrous paper sheets standing in front
-//!   of a lit checkerboard (the supplement's Figure 1).
-//! - `backlit`: a folded sheet at three thicknesses lit from behind.
-//! - `lightbox`: layers of cut paper (masks) in front of a backlight.
+//! - `checkerboard`: matte, glossy and luster paper sheets in front of a
+//!   checkerboard lit from behind (the supplement's Figure 1).
+//! - `backlit`: folded sheets of three thicknesses, each lit from behind.
+//! - `lightbox`: four layers of cut paper (masks from PNG files) in front of a
+//!   light panel, like a paper-cut light box.
 
 use crate::scene::Scene;
 use crate::spec::{load_scene_str, Resources, SceneError};
@@ -15,7 +16,37 @@ use std::collections::HashMap;
 /// `(name, scene file text, embedded files)`.
 type Builtin = (&'static str, &'static str, &'static [(&'static str, &'static [u8])]);
 
-const BUILTINS: &[Builtin] = &[("scene_ref", include_str!("../../../scenes/scene_ref.toml"), &[])];
+const BUILTINS: &[Builtin] = &[
+    ("scene_ref", include_str!("../../../scenes/scene_ref.toml"), &[]),
+    (
+        "checkerboard",
+        include_str!("../../../scenes/checkerboard.toml"),
+        &[("checker_mask.png", include_bytes!("../../../scenes/checker_mask.png"))],
+    ),
+    ("backlit", include_str!("../../../scenes/backlit.toml"), &[]),
+    (
+        "lightbox",
+        include_str!("../../../scenes/lightbox.toml"),
+        &[
+            (
+                "lightbox_layer1.png",
+                include_bytes!("../../../scenes/lightbox_layer1.png"),
+            ),
+            (
+                "lightbox_layer2.png",
+                include_bytes!("../../../scenes/lightbox_layer2.png"),
+            ),
+            (
+                "lightbox_layer3.png",
+                include_bytes!("../../../scenes/lightbox_layer3.png"),
+            ),
+            (
+                "lightbox_layer4.png",
+                include_bytes!("../../../scenes/lightbox_layer4.png"),
+            ),
+        ],
+    ),
+];
 
 /// Names of the built-in scenes.
 pub fn names() -> Vec<&'static str> {

@@ -285,7 +285,7 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 pub fn load_scene_str(text: &str, file: &str, res: &Resources) -> Result<Scene, SceneError> {
     let spec: SceneSpec = toml::from_str(text).map_err(|e| {
         let entry = match e.span() {
-            Some(s) => format!("line {}", text[..s.start.min(text.len())].matches('\n').count() + 1),
+            Some(s) => entry_at(text, s.start.min(text.len())),
             None => "toml".to_string(),
         };
         SceneError {
@@ -295,6 +295,62 @@ pub fn load_scene_str(text: &str, file: &str, res: &Resources) -> Result<Scene, 
         }
     })?;
     build(&spec, file, res)
+}
+
+/// The entry that byte `offset` of a scene file lies in, and its line: the table
+/// and the key the line assigns, e.g. `materials.NAME.d, line 12`,
+/// `shapes[2].radius, line 40`, `camera, line 3`.
+fn entry_at(text: &str, offset: usize) -> String {
+    let before = &text[..offset];
+    let line = before.matches('\n').count() + 1;
+    let mut table: Option<String> = None;
+    let mut shapes = 0usize;
+    // A header's name is a dotted key: this excludes rows of multi-line arrays such as `[1, 2],`.
+    let is_key = |h: &str| {
+        !h.is_empty()
+            && h.chars()
+                .all(|c| c.is_alphanumeric() || matches!(c, '_' | '-' | '.' | ' ' | '"' | '\''))
+    };
+    for l in before.lines() {
+        let t = l.trim();
+        let t = t.split('#').next().unwrap_or("").trim_end();
+        if !t.ends_with(']') {
+            continue;
+        }
+        let t = &t[..t.len() - 1];
+        if let Some(h) = t
+            .strip_prefix("[[")
+            .and_then(|r| r.strip_suffix(']'))
+            .filter(|h| is_key(h))
+        {
+            let h = h.trim();
+            if h == "shapes" {
+                table = Some(format!("shapes[{shapes}]"));
+                shapes += 1;
+            } else {
+                table = Some(h.to_string());
+            }
+        } else if let Some(h) = t.strip_prefix('[').filter(|h| is_key(h)) {
+            table = Some(h.trim().to_string());
+        }
+    }
+    // The key the line assigns, if it is a `key = value` line.
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let this_line = text[line_start..].lines().next().unwrap_or("");
+    let key = this_line
+        .split_once('=')
+        .map(|(k, _)| k.trim())
+        .filter(|k| is_key(k) && !k.contains(' '));
+    let path = match (table, key) {
+        (Some(t), Some(k)) => Some(format!("{t}.{k}")),
+        (Some(t), None) => Some(t),
+        (None, Some(k)) => Some(k.to_string()),
+        (None, None) => None,
+    };
+    match path {
+        Some(t) => format!("{t}, line {line}"),
+        None => format!("line {line}"),
+    }
 }
 
 fn err(file: &str, entry: &str, message: impl Into<String>) -> SceneError {

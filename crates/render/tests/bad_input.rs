@@ -1,0 +1,232 @@
+//! Bad scene input: every error names the scene file and the entry (and says
+//! what is wrong); nothing is silently ignored or clamped.
+
+use paperbsdf_render::load_scene;
+use std::path::Path;
+
+/// A valid scene; each test breaks one part of it.
+const GOOD: &str = r#"
+[render]
+width = 8
+height = 6
+
+[camera]
+origin = [0, -3, 1]
+target = [0, 0, 0]
+fov = 40
+
+[materials.board]
+type = "diffuse"
+reflectance = { type = "checker", even = 0.8, odd = 0.1 }
+
+[materials.sheet]
+type = "paper"
+preset = "matte"
+
+[[shapes]]
+name = "floor"
+type = "rectangle"
+material = "board"
+
+[[shapes]]
+name = "sheet"
+type = "rectangle"
+material = "sheet"
+transform = [{ rotate = [1, 0, 0], angle = 90 }]
+
+[[shapes]]
+name = "lamp"
+type = "sphere"
+center = [0, 0, 3]
+radius = 0.5
+emission = 5
+"#;
+
+/// Writes `text` as `dir/scene.toml` and loads it; returns the error message.
+fn load_err(dir: &Path, text: &str) -> String {
+    let p = dir.join("scene.toml");
+    std::fs::write(&p, text).unwrap();
+    match load_scene(&p) {
+        Ok(_) => panic!("scene loaded but should not have:\n{text}"),
+        Err(e) => {
+            let m = e.to_string();
+            eprintln!("{m}");
+            assert!(
+                m.contains(&p.display().to_string()),
+                "message does not name the file: {m}"
+            );
+            m
+        }
+    }
+}
+
+fn contains_all(m: &str, parts: &[&str]) {
+    for p in parts {
+        assert!(m.contains(p), "message does not contain `{p}`: {m}");
+    }
+}
+
+#[test]
+fn good_scene_loads() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("scene.toml");
+    std::fs::write(&p, GOOD).unwrap();
+    load_scene(&p).unwrap();
+}
+
+#[test]
+fn unknown_key() {
+    let dir = tempfile::tempdir().unwrap();
+    // In a material table.
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace("preset = \"matte\"", "preset = \"matte\"\nthicknes = 0.2"),
+    );
+    contains_all(&m, &["materials.sheet", "line 18", "thicknes"]);
+    // In the second shape.
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace("name = \"sheet\"", "name = \"sheet\"\ncolour = 1"),
+    );
+    contains_all(&m, &["shapes[1]", "colour"]);
+    // In the camera.
+    let m = load_err(dir.path(), &GOOD.replace("fov = 40", "fov = 40\nzoom = 2"));
+    contains_all(&m, &["camera", "zoom"]);
+    // A key that exists but belongs to another material type.
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace("preset = \"matte\"", "preset = \"matte\"\nreflectance = 0.5"),
+    );
+    contains_all(&m, &["materials.sheet", "reflectance", "does not apply"]);
+    // A key that belongs to another shape type.
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace("radius = 0.5", "radius = 0.5\nfile = \"x.obj\""),
+    );
+    contains_all(&m, &["shapes[2] (lamp)", "file", "does not apply"]);
+}
+
+#[test]
+fn missing_texture_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace(
+            "reflectance = { type = \"checker\", even = 0.8, odd = 0.1 }",
+            "reflectance = { type = \"image\", file = \"no_such_board.png\" }",
+        ),
+    );
+    contains_all(&m, &["materials.board", "reflectance", "no_such_board.png"]);
+    // A missing mask, thickness map and ink map.
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace("name = \"sheet\"", "name = \"sheet\"\nmask = \"gone.png\""),
+    );
+    contains_all(&m, &["shapes[1] (sheet)", "mask", "gone.png"]);
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace(
+            "preset = \"matte\"",
+            "preset = \"matte\"\nthickness_map = { file = \"watermark.png\", min = 0.5 }",
+        ),
+    );
+    contains_all(&m, &["materials.sheet", "thickness_map", "watermark.png"]);
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace(
+            "preset = \"matte\"",
+            "preset = \"matte\"\nink_map = { file = \"print.png\", sigma_a = 20 }",
+        ),
+    );
+    contains_all(&m, &["materials.sheet", "ink_map", "print.png"]);
+    // A file that exists but is not an image.
+    std::fs::write(dir.path().join("fake.png"), "not a png").unwrap();
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace("name = \"sheet\"", "name = \"sheet\"\nmask = \"fake.png\""),
+    );
+    contains_all(&m, &["shapes[1] (sheet)", "mask", "fake.png"]);
+}
+
+#[test]
+fn mesh_that_fails_to_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj_shape = "[[shapes]]\nname = \"statue\"\ntype = \"obj\"\nfile = \"statue.obj\"\nmaterial = \"board\"\n";
+    let scene = format!("{GOOD}\n{obj_shape}");
+    // Missing file.
+    let m = load_err(dir.path(), &scene);
+    contains_all(&m, &["shapes[3] (statue)", "statue.obj"]);
+    // A face that refers to a vertex that does not exist.
+    std::fs::write(dir.path().join("statue.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap();
+    let m = load_err(dir.path(), &scene);
+    contains_all(&m, &["shapes[3] (statue)", "statue.obj"]);
+    // Garbage in place of numbers.
+    std::fs::write(dir.path().join("statue.obj"), "v 0 zero 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let m = load_err(dir.path(), &scene);
+    contains_all(&m, &["shapes[3] (statue)", "statue.obj"]);
+    // No triangles at all.
+    std::fs::write(dir.path().join("statue.obj"), "# empty\nv 0 0 0\n").unwrap();
+    let m = load_err(dir.path(), &scene);
+    contains_all(&m, &["shapes[3] (statue)", "statue.obj", "no triangles"]);
+    // And a good mesh loads.
+    std::fs::write(dir.path().join("statue.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let p = dir.path().join("scene.toml");
+    std::fs::write(&p, &scene).unwrap();
+    let s = load_scene(&p).unwrap();
+    assert_eq!(s.objects.len(), 4);
+}
+
+#[test]
+fn invalid_parameter() {
+    let dir = tempfile::tempdir().unwrap();
+    // A paper parameter outside its range (DESIGN.md section 3): named with its value.
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace("preset = \"matte\"", "preset = \"matte\"\nm_f = 2.5"),
+    );
+    contains_all(&m, &["materials.sheet", "m_f", "2.5"]);
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace("preset = \"matte\"", "preset = \"matte\"\nd = -0.1"),
+    );
+    contains_all(&m, &["materials.sheet", "d", "-0.1"]);
+    // An unknown preset lists the available ones.
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace("preset = \"matte\"", "preset = \"newsprint\""),
+    );
+    contains_all(&m, &["materials.sheet", "newsprint", "matte", "luster", "glossy"]);
+    // A reflectance above one.
+    let m = load_err(dir.path(), &GOOD.replace("even = 0.8", "even = 1.2"));
+    contains_all(&m, &["materials.board", "reflectance.even", "1.2"]);
+    // A dielectric index outside [1, 5].
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace(
+            "[materials.sheet]",
+            "[materials.glass]\ntype = \"dielectric\"\neta = 0.5\n\n[materials.sheet]",
+        ),
+    );
+    contains_all(&m, &["materials.glass", "eta", "0.5"]);
+    // A negative radius, a negative emission, an unknown material, a wrong value type.
+    let m = load_err(dir.path(), &GOOD.replace("radius = 0.5", "radius = -0.5"));
+    contains_all(&m, &["shapes[2] (lamp)", "radius", "-0.5"]);
+    let m = load_err(dir.path(), &GOOD.replace("emission = 5", "emission = -5"));
+    contains_all(&m, &["shapes[2] (lamp)", "emission"]);
+    let m = load_err(dir.path(), &GOOD.replace("material = \"sheet\"", "material = \"shet\""));
+    contains_all(&m, &["shapes[1] (sheet)", "shet"]);
+    let m = load_err(dir.path(), &GOOD.replace("fov = 40", "fov = \"wide\""));
+    contains_all(&m, &["camera", "fov"]);
+    // A folded sheet with a fold angle of 90 degrees or more.
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace(
+            "name = \"sheet\"\ntype = \"rectangle\"",
+            "name = \"sheet\"\ntype = \"folded\"\nfold_angle = 95",
+        ),
+    );
+    contains_all(&m, &["shapes[1] (sheet)", "fold_angle", "95"]);
+    // Zero samples per pixel.
+    let m = load_err(dir.path(), &GOOD.replace("height = 6", "height = 6\nspp = 0"));
+    contains_all(&m, &["render", "spp"]);
+}
