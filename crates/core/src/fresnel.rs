@@ -27,9 +27,11 @@ pub fn fresnel_dielectric(cos_i: f64, eta: f64) -> f64 {
         return 1.0;
     }
     let cos_t = (1.0 - sin2_t).sqrt();
-    let a_s = (cos_i - eta_it * cos_t) / (cos_i + eta_it * cos_t);
-    let a_p = (cos_t - eta_it * cos_i) / (cos_t + eta_it * cos_i);
-    0.5 * (a_s * a_s + a_p * a_p)
+    // r_s = n_s / d_s, r_p = n_p / d_p, summed over one division.
+    let (n_s, d_s) = (cos_i - eta_it * cos_t, cos_i + eta_it * cos_t);
+    let (n_p, d_p) = (cos_t - eta_it * cos_i, cos_t + eta_it * cos_i);
+    let (d_s2, d_p2) = (d_s * d_s, d_p * d_p);
+    0.5 * (n_s * n_s * d_p2 + n_p * n_p * d_s2) / (d_s2 * d_p2)
 }
 
 /// Cosine of the transmitted direction for light at `cos_i` (sign convention as

@@ -75,9 +75,9 @@ pub fn coordinate_system(n: DVec3) -> (DVec3, DVec3) {
 #[inline]
 pub fn sample_cosine_hemisphere(u: [f64; 2]) -> DVec3 {
     let r = u[0].sqrt();
-    let phi = 2.0 * std::f64::consts::PI * u[1];
+    let (sin, cos) = (2.0 * std::f64::consts::PI * u[1]).sin_cos();
     let z = (1.0 - u[0]).max(0.0).sqrt();
-    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+    DVec3::new(r * cos, r * sin, z)
 }
 
 /// Uniform direction on the unit sphere.
@@ -85,6 +85,6 @@ pub fn sample_cosine_hemisphere(u: [f64; 2]) -> DVec3 {
 pub fn sample_uniform_sphere(u: [f64; 2]) -> DVec3 {
     let z = 1.0 - 2.0 * u[0];
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * std::f64::consts::PI * u[1];
-    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (sin, cos) = (2.0 * std::f64::consts::PI * u[1]).sin_cos();
+    DVec3::new(r * cos, r * sin, z)
 }

@@ -31,9 +31,9 @@ pub fn sample_hg_cos(g: f64, u: f64) -> f64 {
 #[inline]
 pub fn direction_at(dir: DVec3, cos: f64, u: f64) -> DVec3 {
     let sin = (1.0 - cos * cos).max(0.0).sqrt();
-    let phi = 2.0 * PI * u;
+    let (sp, cp) = (2.0 * PI * u).sin_cos();
     let (t, b) = coordinate_system(dir);
-    (sin * phi.cos() * t + sin * phi.sin() * b + cos * dir).normalize()
+    (sin * cp * t + sin * sp * b + cos * dir).normalize()
 }
 
 /// The Paper BSDF's phase function: a backward and a forward HG lobe.

@@ -47,6 +47,10 @@ pub(crate) struct Face {
     att_tab: [f64; NA],
     /// Outside reflectance of a rough face on the same nodes.
     r_tab: [f64; NA],
+    /// `1 / eta` (the BSDF's inner loop multiplies rather than divides).
+    inv_eta: f64,
+    /// `1 / eta^2`.
+    inv_eta2: f64,
 }
 
 /// Nodes of the per-face copies of `Att` and the outside reflectance.
@@ -93,6 +97,8 @@ impl Face {
             abar: 1.0,
             att_tab: [0.0; NA],
             r_tab: [0.0; NA],
+            inv_eta: 1.0 / eta,
+            inv_eta2: 1.0 / (eta * eta),
         };
         for k in 0..NA {
             let t = k as f64 / (NA - 1) as f64;
@@ -172,11 +178,22 @@ impl Face {
         self.si.rho_in
     }
 
+    /// `1 / eta`.
+    #[inline]
+    pub fn inv_eta(&self) -> f64 {
+        self.inv_eta
+    }
+
+    /// `1 / eta^2`: the change of radiance on leaving through this face.
+    #[inline]
+    pub fn inv_eta2(&self) -> f64 {
+        self.inv_eta2
+    }
+
     /// Cosine (magnitude) inside of the smooth refraction of an outside direction with cosine `mu`.
     #[inline]
     pub fn inside_cos(&self, mu: f64) -> f64 {
-        let e = self.bd.eta;
-        (1.0 - (1.0 - mu * mu) / (e * e)).max(0.0).sqrt()
+        (1.0 - (1.0 - mu * mu) * self.inv_eta2).max(0.0).sqrt()
     }
 
     /// The microfacet distribution, if rough.
@@ -204,10 +221,21 @@ impl Face {
     /// the face frame on the outside (`z > 0`); zero for a smooth or index-matched face.
     #[inline]
     pub fn reflection(&self, wi: DVec3, wo: DVec3) -> f64 {
-        match self.bd.interface {
-            Interface::Rough(_) => self.bd.eval_mode(wi, wo, crate::TransportMode::Radiance),
-            _ => 0.0,
+        let Interface::Rough(mf) = self.bd.interface else {
+            return 0.0;
+        };
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return 0.0;
         }
+        let h = wi + wo;
+        let hl = h.length();
+        if hl == 0.0 || !hl.is_finite() {
+            return 0.0;
+        }
+        let h = h / hl;
+        // Both directions are above the face, so both see the front of `h`
+        // (`w.h = (1 + wi.wo) / |wi + wo| >= 0`).
+        fresnel_dielectric(wo.dot(h), self.bd.eta) * mf.reflection_dg(wi, wo, h)
     }
 
     /// Density of [`Face::sample_reflection`]: `pdf_visible(wo, h) / (4 |wo.h|)`.

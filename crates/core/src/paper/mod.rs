@@ -53,7 +53,7 @@ use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample};
 use crate::fresnel::fresnel_dielectric;
 use crate::geometry::sample_cosine_hemisphere;
 use crate::params::{PaperParams, ParamError};
-use crate::phase::{direction_at, hg, sample_hg_cos};
+use crate::phase::{direction_at, sample_hg_cos};
 use crate::quadrature::gauss_legendre_01;
 use crate::spectrum::Rgb;
 use direct::SheetKernel;
@@ -246,6 +246,8 @@ pub struct PaperBsdf {
     /// Non-degenerate HG lobes `(g, weight)`; a lobe with `|g| = 1` is a delta
     /// in direction and contributes nothing to `eval` (see [`PaperBsdf::new`]).
     lobes: [(f64, f64); 2],
+    /// Per lobe `(w (1 - g^2) / (4 pi), 1 + g^2, 2 g)`: [`PaperBsdf::phase`]'s constants.
+    lobe_hg: [(f64, f64, f64); 2],
     lobe_sum: f64,
     albedo: Rgb,
     tau: Rgb,
@@ -254,6 +256,13 @@ pub struct PaperBsdf {
     ms_albedo: [Rgb; 2],
     s_tab: [[Rgb; NS]; 2],
     ess_tab: [[Rgb; NS]; 2],
+    /// Per face of exit and node of [`NS`]: the channel means of the single,
+    /// multiple-reflection and multiple-transmission albedo estimates that
+    /// [`PaperBsdf::lobe_probs`] weighs the lobes by (before the `Att` factor).
+    lobe_tab: [[[f64; 3]; NS]; 2],
+    /// Per face of exit: whether the single, multiple-reflection and
+    /// multiple-transmission lobes carry any light.
+    lobe_present: [[bool; 3]; 2],
     kernel: SheetKernel,
     opts: PaperOptions,
     is_rgb: bool,
@@ -314,6 +323,7 @@ impl PaperBsdf {
             }
         }
         let lobe_sum = lobes[0].1 + lobes[1].1;
+        let lobe_hg = lobes.map(|(g, w)| (w * (1.0 - g * g) / (4.0 * PI), 1.0 + g * g, 2.0 * g));
         let mean_cos = p.w_b * p.g_b + (1.0 - p.w_b) * p.g_f;
         let sigma_s_p = sigma_s * (1.0 - mean_cos);
         let kernel = SheetKernel::new([
@@ -323,6 +333,7 @@ impl PaperBsdf {
         let mut me = PaperBsdf {
             faces,
             lobes,
+            lobe_hg,
             lobe_sum,
             albedo,
             tau,
@@ -331,6 +342,8 @@ impl PaperBsdf {
             ms_albedo: [Rgb::ZERO; 2],
             s_tab: [[Rgb::ONE; NS]; 2],
             ess_tab: [[Rgb::ZERO; NS]; 2],
+            lobe_tab: [[[0.0; 3]; NS]; 2],
+            lobe_present: [[false; 3]; 2],
             kernel,
             opts,
             is_rgb: p.is_rgb(),
@@ -367,6 +380,22 @@ impl PaperBsdf {
             me.ms_albedo[e] = me.c_r[e] * (PI * fe.abar) + me.c_t[e] * (PI * fx.abar);
         }
         me.build_tables(symmetric);
+        for x in 0..2 {
+            me.lobe_present[x] = [
+                me.lobe_sum > 0.0 && me.albedo.max_channel() > 0.0,
+                me.c_r[x].max_channel() > 0.0,
+                me.c_t[x].max_channel() > 0.0,
+            ];
+            let (abar_x, abar_o) = (me.faces[x].abar, me.faces[1 - x].abar);
+            for k in 0..NS {
+                let s = if opts.energy_bound { me.s_tab[x][k] } else { Rgb::ONE };
+                me.lobe_tab[x][k] = [
+                    me.ess_tab[x][k].mean(),
+                    (me.c_r[x] * s).mean() * PI * abar_x,
+                    (me.c_t[x] * s).mean() * PI * abar_o,
+                ];
+            }
+        }
         Ok(me)
     }
 
@@ -523,13 +552,12 @@ impl PaperBsdf {
     /// The mixture phase function (non-degenerate lobes) at cosine `cos`.
     #[inline]
     fn phase(&self, cos: f64) -> f64 {
-        let mut p = 0.0;
-        for &(g, w) in &self.lobes {
-            if w > 0.0 {
-                p += w * hg(cos, g);
-            }
-        }
-        p
+        // w HG(cos; g) = k / (q sqrt(q)), q = 1 + g^2 - 2 g cos: both lobes
+        // with one division (an absent lobe has k = 0 and q = 1).
+        let [(k0, a0, b0), (k1, a1, b1)] = self.lobe_hg;
+        let (q0, q1) = (a0 - b0 * cos, a1 - b1 * cos);
+        let (d0, d1) = (q0 * q0.sqrt(), q1 * q1.sqrt());
+        (k0 * d1 + k1 * d0) / (d0 * d1)
     }
 
     /// Inside propagation directions `(t_i, t_o)` and cosines for outside `wi`, `wo`.
@@ -538,8 +566,8 @@ impl PaperBsdf {
         let (fe, fx) = (&self.faces[side(wi)], &self.faces[side(wo)]);
         let mu_i = fe.inside_cos(wi.z.abs());
         let mu_o = fx.inside_cos(wo.z.abs());
-        let t_i = DVec3::new(-wi.x / fe.eta(), -wi.y / fe.eta(), -wi.z.signum() * mu_i);
-        let t_o = DVec3::new(wo.x / fx.eta(), wo.y / fx.eta(), wo.z.signum() * mu_o);
+        let t_i = DVec3::new(-wi.x * fe.inv_eta(), -wi.y * fe.inv_eta(), -wi.z.signum() * mu_i);
+        let t_o = DVec3::new(wo.x * fx.inv_eta(), wo.y * fx.inv_eta(), wo.z.signum() * mu_o);
         (t_i, t_o, mu_i, mu_o)
     }
 
@@ -601,30 +629,28 @@ impl PaperBsdf {
         if set.contains(Component::Single) && self.lobe_sum > 0.0 {
             let p = g.p;
             if p > 0.0 {
-                let k = att * p / (fx.eta() * fx.eta());
-                let (inv_i, inv_o) = (1.0 / mu_i, 1.0 / mu_o);
-                let depth = |tau: f64| {
-                    if reflect {
-                        // tau (1/mu_i + 1/mu_o) > 40: the exponential is below
-                        // 4e-18 of 1; skip it (thick paper).
-                        if tau * (inv_i + inv_o) > 40.0 && tau.is_finite() {
-                            1.0 / (mu_i + mu_o)
-                        } else {
-                            single::depth_reflection(tau, mu_i, mu_o)
-                        }
-                    } else if tau * inv_i.min(inv_o) > 40.0 {
-                        // Both paths through the sheet are attenuated by more
-                        // than e^{-40}: dropped like the direct term below.
-                        0.0
-                    } else {
-                        single::depth_transmission(tau, mu_i, mu_o)
-                    }
-                };
-                if self.grey {
-                    out += Rgb::splat(k * self.albedo.0[0] * depth(self.tau.0[0]));
+                let k = att * p * fx.inv_eta2();
+                if reflect && self.tau_min * (mu_i + mu_o) > 40.0 * mu_i * mu_o {
+                    // tau (1/mu_i + 1/mu_o) > 40 in every channel: the
+                    // exponential is below 4e-18 of 1; skip it (thick paper).
+                    out += self.albedo * (k / (mu_i + mu_o));
+                } else if !reflect && self.tau_min > 40.0 * mu_i.max(mu_o) {
+                    // Both paths through the sheet are attenuated by more
+                    // than e^{-40}: dropped like the direct term below.
                 } else {
-                    for c in 0..3 {
-                        out.0[c] += k * self.albedo.0[c] * depth(self.tau.0[c]);
+                    let depth = |tau: f64| {
+                        if reflect {
+                            single::depth_reflection(tau, mu_i, mu_o)
+                        } else {
+                            single::depth_transmission(tau, mu_i, mu_o)
+                        }
+                    };
+                    if self.grey {
+                        out += Rgb::splat(k * self.albedo.0[0] * depth(self.tau.0[0]));
+                    } else {
+                        for c in 0..3 {
+                            out.0[c] += k * self.albedo.0[c] * depth(self.tau.0[c]);
+                        }
                     }
                 }
             }
@@ -711,17 +737,15 @@ impl PaperBsdf {
         let mut present = [false; 5];
         present[0] = !fx.is_index_matched();
         est[0] = fx.r_out_with_sqrt(mu, st);
-        let s = if self.opts.energy_bound {
-            lerp_tab_sqrt(&self.s_tab[x], st)
-        } else {
-            Rgb::ONE
-        };
-        present[1] = self.lobe_sum > 0.0 && self.albedo.max_channel() > 0.0;
-        est[1] = att_o * lerp_tab_sqrt(&self.ess_tab[x], st).mean();
-        present[2] = self.c_r[x].max_channel() > 0.0;
-        est[2] = att_o * (self.c_r[x] * s).mean() * PI * fx.abar;
-        present[3] = self.c_t[x].max_channel() > 0.0;
-        est[3] = att_o * (self.c_t[x] * s).mean() * PI * fo.abar;
+        // The tabulated channel means of the single and multiple lobes' albedos.
+        let tab = &self.lobe_tab[x];
+        let xs = st * (NS - 1) as f64;
+        let i = (xs as usize).min(NS - 2);
+        let f = xs - i as f64;
+        present[1..4].copy_from_slice(&self.lobe_present[x]);
+        for j in 0..3 {
+            est[1 + j] = att_o * (tab[i][j] * (1.0 - f) + tab[i + 1][j] * f);
+        }
         if self.opts.direct {
             let mu_in = fx.inside_cos(mu).max(1e-6);
             let tm = self.tau.mean();
@@ -744,7 +768,8 @@ impl PaperBsdf {
         if !sum.is_finite() || sum <= 0.0 {
             return [0.0; 5];
         }
-        w.map(|v| v / sum)
+        let inv = 1.0 / sum;
+        w.map(|v| v * inv)
     }
 
     /// Density of the single-scattering strategy: the phase function around
@@ -943,6 +968,7 @@ impl Bsdf for PaperBsdf {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::phase::hg;
 
     /// The closed-form azimuthal integral against a midpoint rule over phi
     /// (4000 points: error far below the 1e-6 asked), narrow and wide lobes,
