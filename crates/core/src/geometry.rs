@@ -71,11 +71,48 @@ pub fn coordinate_system(n: DVec3) -> (DVec3, DVec3) {
     )
 }
 
+/// `(sin 2 pi u, cos 2 pi u)` for `u` in `[0, 1]`, faster than `f64::sin_cos`
+/// for the azimuths of samplers: the turn is reduced to a quarter-turn index
+/// and an angle `x` in `[-pi/4, pi/4]`, where the Taylor series of `sin` to
+/// `x^17` and of `cos` to `x^18` are exact to double precision (next terms
+/// below `1e-19`). Within a few ulps of `f64::sin_cos` (tested).
+#[inline]
+pub fn sin_cos_2pi(u: f64) -> (f64, f64) {
+    let q = (4.0 * u).round();
+    let x = std::f64::consts::TAU * (u - 0.25 * q);
+    let x2 = x * x;
+    // 1/n! for the odd and even terms.
+    let s = x
+        * (1.0
+            + x2 * (-1.0 / 6.0
+                + x2 * (1.0 / 120.0
+                    + x2 * (-1.0 / 5040.0
+                        + x2 * (1.0 / 362_880.0
+                            + x2 * (-1.0 / 39_916_800.0
+                                + x2 * (1.0 / 6_227_020_800.0
+                                    + x2 * (-1.0 / 1_307_674_368_000.0 + x2 * (1.0 / 355_687_428_096_000.0)))))))));
+    let c = 1.0
+        + x2 * (-0.5
+            + x2 * (1.0 / 24.0
+                + x2 * (-1.0 / 720.0
+                    + x2 * (1.0 / 40_320.0
+                        + x2 * (-1.0 / 3_628_800.0
+                            + x2 * (1.0 / 479_001_600.0
+                                + x2 * (-1.0 / 87_178_291_200.0
+                                    + x2 * (1.0 / 20_922_789_888_000.0 + x2 * (-1.0 / 6_402_373_705_728_000.0)))))))));
+    match (q as i64).rem_euclid(4) {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    }
+}
+
 /// Cosine-weighted direction on the upper hemisphere (Malley's method).
 #[inline]
 pub fn sample_cosine_hemisphere(u: [f64; 2]) -> DVec3 {
     let r = u[0].sqrt();
-    let (sin, cos) = (2.0 * std::f64::consts::PI * u[1]).sin_cos();
+    let (sin, cos) = sin_cos_2pi(u[1]);
     let z = (1.0 - u[0]).max(0.0).sqrt();
     DVec3::new(r * cos, r * sin, z)
 }
@@ -85,6 +122,37 @@ pub fn sample_cosine_hemisphere(u: [f64; 2]) -> DVec3 {
 pub fn sample_uniform_sphere(u: [f64; 2]) -> DVec3 {
     let z = 1.0 - 2.0 * u[0];
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let (sin, cos) = (2.0 * std::f64::consts::PI * u[1]).sin_cos();
+    let (sin, cos) = sin_cos_2pi(u[1]);
     DVec3::new(r * cos, r * sin, z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The reduced Taylor series against the standard library over the whole
+    /// turn, quarter-turn boundaries included.
+    #[test]
+    fn sin_cos_2pi_matches_std() {
+        let mut worst = 0.0f64;
+        let n = 100_000;
+        for k in 0..=n {
+            for u in [k as f64 / n as f64, (k as f64 + 0.37) / n as f64] {
+                if u > 1.0 {
+                    continue;
+                }
+                let (s, c) = sin_cos_2pi(u);
+                let (s0, c0) = (std::f64::consts::TAU * u).sin_cos();
+                worst = worst.max((s - s0).abs()).max((c - c0).abs());
+            }
+        }
+        // A few ulps of 1 (2.2e-16), plus the rounding of TAU * u itself
+        // (up to 1.4e-15 near u = 1, where std::sin_cos sees an argument
+        // rounded to an ulp of 2 pi).
+        eprintln!("worst deviation from std: {worst:e}");
+        assert!(worst < 2e-15, "worst {worst:e}");
+        assert_eq!(sin_cos_2pi(0.0), (0.0, 1.0));
+        let (s, c) = sin_cos_2pi(0.25);
+        assert!((s - 1.0).abs() < 1e-16 && c.abs() < 1e-16);
+    }
 }

@@ -219,7 +219,7 @@ impl Microfacet {
         };
         let t2 = vh.cross(t1);
         let r = u[0].sqrt();
-        let (sin_phi, cos_phi) = (2.0 * PI * u[1]).sin_cos();
+        let (sin_phi, cos_phi) = crate::geometry::sin_cos_2pi(u[1]);
         let p1 = r * cos_phi;
         let s = 0.5 * (1.0 + vh.z);
         let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sin_phi;

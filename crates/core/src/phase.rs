@@ -31,7 +31,7 @@ pub fn sample_hg_cos(g: f64, u: f64) -> f64 {
 #[inline]
 pub fn direction_at(dir: DVec3, cos: f64, u: f64) -> DVec3 {
     let sin = (1.0 - cos * cos).max(0.0).sqrt();
-    let (sp, cp) = (2.0 * PI * u).sin_cos();
+    let (sp, cp) = crate::geometry::sin_cos_2pi(u);
     let (t, b) = coordinate_system(dir);
     (sin * cp * t + sin * sp * b + cos * dir).normalize()
 }

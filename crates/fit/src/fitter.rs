@@ -27,6 +27,13 @@ pub struct FitOptions {
     pub final_starts: usize,
     /// Incident angles (degrees) whose points are fitted; `None`: all points.
     pub fit_theta_i: Option<Vec<f64>>,
+    /// Rounds of basin hopping after the local refinement: each round refines
+    /// [`FitOptions::hop_starts`] random perturbations of the best point so far
+    /// (normal, standard deviation 0.3, 0.15, 0.075, ... of the unit box) and
+    /// keeps the best; escapes local minima that every start fell into.
+    pub hop_rounds: usize,
+    /// Perturbations refined per round of basin hopping (in parallel).
+    pub hop_starts: usize,
     /// Seed of the global stage.
     pub seed: u64,
     /// Show a progress bar on stderr.
@@ -42,6 +49,8 @@ impl Default for FitOptions {
             screen_iter: 8,
             final_starts: 4,
             fit_theta_i: None,
+            hop_rounds: 3,
+            hop_starts: 4,
             seed: 1,
             progress: false,
         }
@@ -260,7 +269,9 @@ pub fn fit(
     }
     let screening = opts.screen_iter > 0 && chosen.len() > opts.final_starts.max(1);
     let n_final = if screening { opts.final_starts.max(1) } else { 0 };
-    pb.set_length((candidates.len() * opts.global_samples + chosen.len() + n_final) as u64);
+    pb.set_length(
+        (candidates.len() * opts.global_samples + chosen.len() + n_final + opts.hop_rounds * opts.hop_starts) as u64,
+    );
     let refine = |starts: Vec<(usize, Vec<f64>)>, lm: LmSettings| -> Vec<(usize, crate::optimize::LmResult)> {
         starts
             .into_par_iter()
@@ -288,12 +299,38 @@ pub fn fit(
         let finals: Vec<(usize, Vec<f64>)> = results.iter().take(n_final).map(|r| (r.0, r.1.u.clone())).collect();
         results = refine(finals, opts.lm);
     }
-    pb.finish_and_clear();
     evaluations += results.iter().map(|r| r.1.evaluations).sum::<usize>();
-    let (ci, best) = results
+    let (ci, mut best) = results
         .into_iter()
         .min_by(|a, b| a.1.cost.partial_cmp(&b.1.cost).unwrap_or(std::cmp::Ordering::Equal))
         .unwrap();
+    // Basin hopping within the winning variant.
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(opts.seed ^ 0x6A09_E667_F3BC_C908);
+    for round in 0..opts.hop_rounds {
+        let sd = 0.3 * 0.5f64.powi(round as i32);
+        let starts: Vec<(usize, Vec<f64>)> = (0..opts.hop_starts)
+            .map(|_| {
+                let u = best
+                    .u
+                    .iter()
+                    .map(|&x| {
+                        // Box-Muller normal deviate, the result kept inside the box.
+                        let (a, b): (f64, f64) = (rng.gen::<f64>().max(1e-300), rng.gen());
+                        let z = (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos();
+                        (x + sd * z).clamp(0.0, 1.0)
+                    })
+                    .collect();
+                (ci, u)
+            })
+            .collect();
+        for (_, r) in refine(starts, opts.lm) {
+            evaluations += r.evaluations;
+            if r.cost < best.cost && r.stop.converged() {
+                best = r;
+            }
+        }
+    }
+    pb.finish_and_clear();
     let c = candidates[ci].as_ref();
     if !best.stop.converged() {
         return Err(FitError::NotConverged {

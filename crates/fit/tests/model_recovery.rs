@@ -3,8 +3,9 @@
 //! box are fitted back to an RMS log error below 1e-3, starting from the
 //! default start plus the global stage. To keep the test fast the microfacet
 //! distributions are given (the variant is not searched); every continuous
-//! parameter is free except in `paper_recovers_medium_with_faces_given` and the data are two incident angles, theta_o in steps
-//! of 20 degrees, reflection and transmission (36 points).
+//! parameter is free except in `paper_recovers_medium_with_faces_given`. The
+//! data are two incident angles, theta_o in steps of 20 degrees, reflection
+//! and transmission (36 points).
 
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::Distribution;
@@ -53,11 +54,9 @@ fn recover(name: &str, dists: &[Distribution], seed: u64, trials: usize) {
 
 #[test]
 fn paper_recovers_medium_with_faces_given() {
-    // Fewer free parameters (the five of the medium; the faces are given):
-    // with all nine free, trial 0 of seed 11 ends in a local minimum at RMS
-    // 0.0066 (a rougher back face traded against the phase function), even
-    // with 16 starts; see the report. The all-free case is
-    // `paper_recovers_beckmann` below.
+    // Fewer free parameters (the five of the medium; the faces are given), a
+    // smaller global stage. The all-free cases are `paper_recovers_beckmann`
+    // and `paper_recovers_all_free_ggx` below.
     let mut rng = rand_pcg::Pcg64::seed_from_u64(11);
     for trial in 0..2 {
         let truth_model = &candidates("paper", Some(0.15), false, Some(&[Distribution::Ggx])).unwrap()[0];
@@ -96,7 +95,7 @@ fn paper_recovers_medium_with_faces_given() {
 #[test]
 fn paper_recovers_beckmann() {
     // All nine continuous parameters free.
-    recover("paper", &[Distribution::Beckmann], 12, 1);
+    recover("paper", &[Distribution::Beckmann], 12, 3);
 }
 
 #[test]
@@ -118,13 +117,13 @@ fn paper_needs_thickness() {
     assert!(e.contains("unknown model `papr`"), "{e}");
 }
 
-/// KNOWN FAILURE, kept to document it (run with `--ignored`): with all nine
-/// parameters free, trial 0 of seed 11 (truth: a fairly smooth back face,
-/// m_b = 0.14, weakly scattering medium, albedo 0.88) ends in a local minimum
-/// at RMS 0.0066 (m_b = 0.58, a different phase function) with the default
-/// global stage and even with 48 samples and 16 starts.
+/// All nine parameters free, GGX faces. Trial 0 of seed 11 (truth: a fairly
+/// smooth back face, m_b = 0.14, weakly scattering medium, albedo 0.88) used to
+/// end in a local minimum at RMS 0.0066 (m_b = 0.58, a different phase
+/// function) that every start of the global stage fell into, even with 48
+/// samples and 16 starts; the basin hopping stage after the local refinement
+/// (`FitOptions::hop_rounds`) gets out of it.
 #[test]
-#[ignore]
 fn paper_recovers_all_free_ggx() {
-    recover("paper", &[Distribution::Ggx], 11, 2);
+    recover("paper", &[Distribution::Ggx], 11, 4);
 }

@@ -89,7 +89,7 @@ impl SheetKernel {
             KernelShape::Ggx(b) => b * b * u[0] / (1.0 - u[0]).max(1e-300),
             KernelShape::Gauss(b) => -b * b * (1.0 - u[0]).max(1e-300).ln(),
         };
-        let (s, c) = (2.0 * PI * u[1]).sin_cos();
+        let (s, c) = crate::geometry::sin_cos_2pi(u[1]);
         r2.sqrt() * DVec2::new(c, s)
     }
 
