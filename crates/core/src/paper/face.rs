@@ -274,18 +274,8 @@ impl Face {
             return (0.0, 0.0);
         }
         let h = h / hl;
-        let d = mf.d(h);
-        if d == 0.0 {
-            return (0.0, 0.0);
-        }
-        let oh = wo.dot(h);
-        let f = fresnel_dielectric(oh, self.bd.eta) * d * mf.g(wo, wi, h) / (4.0 * wo.z * wi.z);
-        let pdf = if oh > 0.0 {
-            mf.g1_exact(wo, h) * d / (4.0 * wo.z)
-        } else {
-            0.0
-        };
-        (f, pdf)
+        let (dg, pdf) = mf.reflection_dg_pdf(wi, wo, h);
+        (fresnel_dielectric(wo.dot(h), self.bd.eta) * dg, pdf)
     }
 
     /// Draws a reflected `wi` (face frame) from the visible normals seen from `wo`.

@@ -779,8 +779,7 @@ impl PaperBsdf {
         if g.mu_i <= 0.0 || self.lobe_sum <= 0.0 {
             return 0.0;
         }
-        let eta = self.faces[side(wi)].eta();
-        g.p / self.lobe_sum * wi.z.abs() / (eta * eta * g.mu_i)
+        g.p * wi.z.abs() * self.faces[side(wi)].inv_eta2() / (self.lobe_sum * g.mu_i)
     }
 
     fn pdf_with(&self, wi: DVec3, wo: DVec3, pr: &[f64; 5], pre: Option<&Inside>) -> f64 {
@@ -840,7 +839,6 @@ impl Bsdf for PaperBsdf {
         if pr[k] <= 0.0 {
             return None;
         }
-        let ucr = ((uc - acc) / pr[k]).clamp(0.0, 1.0 - 1e-16);
         let x = side(wo);
         let sx = if x == 0 { 1.0 } else { -1.0 };
         let wi = match k {
@@ -862,6 +860,8 @@ impl Bsdf for PaperBsdf {
                 let fx = &self.faces[x];
                 let mu_o = fx.inside_cos(wo.z.abs());
                 let t_o = DVec3::new(wo.x / fx.eta(), wo.y / fx.eta(), sx * mu_o).normalize();
+                // Reuse the lobe-choice number to pick the HG lobe.
+                let ucr = ((uc - acc) / pr[k]).clamp(0.0, 1.0 - 1e-16);
                 let g = if ucr * self.lobe_sum < self.lobes[0].1 {
                     self.lobes[0].0
                 } else {
