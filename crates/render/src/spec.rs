@@ -146,6 +146,8 @@ pub struct MaterialSpec {
     pub dist: Option<Distribution>,
     /// paper: a preset name.
     pub preset: Option<String>,
+    /// paper: a parameter file (JSON or TOML, the format of `paperbsdf eval --params`), relative to the scene file.
+    pub params: Option<String>,
     /// paper: thickness, mm.
     pub d: Option<f64>,
     /// paper: absorption, 1/mm.
@@ -470,8 +472,9 @@ fn grey_image(
 
 /// Keys set in a material table that do not belong to its type.
 fn foreign_keys(m: &MaterialSpec, allowed: &[&str]) -> Vec<&'static str> {
-    let present: [(&'static str, bool); 19] = [
+    let present: [(&'static str, bool); 20] = [
         ("reflectance", m.reflectance.is_some()),
+        ("params", m.params.is_some()),
         ("eta", m.eta.is_some()),
         ("m", m.m.is_some()),
         ("dist", m.dist.is_some()),
@@ -498,8 +501,34 @@ fn foreign_keys(m: &MaterialSpec, allowed: &[&str]) -> Vec<&'static str> {
         .collect()
 }
 
-/// The parameters of a paper material: a preset with overrides, or a full set.
-fn paper_params(m: &MaterialSpec, entry: &str, file: &str) -> Result<PaperParams, SceneError> {
+/// Reads a paper parameter file (embedded for built-in scenes, else relative to the scene file).
+fn params_file(rel: &str, res: &Resources) -> Result<PaperParams, String> {
+    let loaded = if let Some(b) = res.embedded.get(rel) {
+        let text = std::str::from_utf8(b).map_err(|e| format!("parameter file '{rel}': {e}"))?;
+        let is_toml = rel.to_ascii_lowercase().ends_with(".toml");
+        paperbsdf_io::Loaded {
+            value: paperbsdf_io::params::parse_text::<PaperParams>(text, rel, is_toml).map_err(|e| e.to_string())?,
+            origin: rel.to_string(),
+            text: text.to_string(),
+            is_toml,
+        }
+    } else {
+        let path = res.base_dir.join(rel);
+        paperbsdf_io::load_params::<PaperParams>(&path.to_string_lossy()).map_err(|e| e.to_string())?
+    };
+    loaded.value.validate().map_err(|e| loaded.param_error(e).to_string())?;
+    Ok(loaded.value)
+}
+
+/// The parameters of a paper material: a preset or a parameter file with overrides, or a full set.
+fn paper_params(m: &MaterialSpec, entry: &str, file: &str, res: &Resources) -> Result<PaperParams, SceneError> {
+    if m.preset.is_some() && m.params.is_some() {
+        return Err(err(file, entry, "give `preset` or `params`, not both"));
+    }
+    if let Some(rel) = &m.params {
+        let base = Some(params_file(rel, res).map_err(|e| err(file, entry, format!("`params`: {e}")))?);
+        return paper_params_over(m, base, entry, file);
+    }
     let base = match &m.preset {
         Some(name) => Some(paper_model::preset(name).ok_or_else(|| {
             let names = paper_model::preset_names();
@@ -518,6 +547,16 @@ fn paper_params(m: &MaterialSpec, entry: &str, file: &str) -> Result<PaperParams
         })?),
         None => None,
     };
+    paper_params_over(m, base, entry, file)
+}
+
+/// The material's paper keys over `base` (a preset or parameter file, if any), validated.
+fn paper_params_over(
+    m: &MaterialSpec,
+    base: Option<PaperParams>,
+    entry: &str,
+    file: &str,
+) -> Result<PaperParams, SceneError> {
     macro_rules! pick {
         ($f:ident) => {
             match (&m.$f, &base) {
@@ -527,7 +566,10 @@ fn paper_params(m: &MaterialSpec, entry: &str, file: &str) -> Result<PaperParams
                     return Err(err(
                         file,
                         entry,
-                        format!("paper needs `{}` (or a `preset`)", stringify!($f)),
+                        format!(
+                            "paper needs `{}` (or a `preset` or `params` file)",
+                            stringify!($f)
+                        ),
                     ))
                 }
             }
@@ -566,6 +608,7 @@ fn material(name: &str, m: &MaterialSpec, file: &str, res: &Resources) -> Result
         "dielectric" => &["eta", "m", "dist"],
         "paper" => &[
             "preset",
+            "params",
             "d",
             "sigma_a",
             "sigma_s",
@@ -620,7 +663,7 @@ fn material(name: &str, m: &MaterialSpec, file: &str, res: &Resources) -> Result
             Material::Fixed(Arc::new(b))
         }
         "paper" => {
-            let p = paper_params(m, entry, file)?;
+            let p = paper_params(m, entry, file, res)?;
             let thickness = match &m.thickness_map {
                 None => None,
                 Some(t) => {

@@ -101,7 +101,7 @@ pub enum ColourTexture {
         /// Squares per unit of `u` and `v`.
         scale: f64,
     },
-    /// An image (linear RGB), scaled by `scale` squares per unit... repeats `scale` times.
+    /// An image (linear RGB), repeated `scale` times per unit of `u` and `v`.
     Image {
         /// The image.
         image: Arc<Image>,

@@ -230,3 +230,47 @@ fn invalid_parameter() {
     let m = load_err(dir.path(), &GOOD.replace("height = 6", "height = 6\nspp = 0"));
     contains_all(&m, &["render", "spp"]);
 }
+
+/// A paper material from a parameter file (the format of `paperbsdf eval --params`):
+/// it loads, keys of the material override it, and its errors name the scene
+/// file, the material, the parameter file and the parameter.
+#[test]
+fn paper_parameter_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = r#"{
+  "d": 0.1, "sigma_a": 0.6, "sigma_s": [120, 110, 100],
+  "g_f": 0.85, "g_b": -0.4, "w_b": 0.15,
+  "eta_f": 1.45, "eta_b": 1.45, "m_f": 0.35, "m_b": 0.35,
+  "dist_f": "ggx", "dist_b": "ggx"
+}"#;
+    std::fs::write(dir.path().join("paper.json"), good).unwrap();
+    let scene = GOOD.replace("preset = \"matte\"", "params = \"paper.json\"\nd = 0.2");
+    let p = dir.path().join("scene.toml");
+    std::fs::write(&p, &scene).unwrap();
+    let s = load_scene(&p).unwrap();
+    match &s.materials[1] {
+        paperbsdf_render::material::Material::Paper(pm) => {
+            assert_eq!(pm.base.d, 0.2, "the material's `d` overrides the file's");
+            assert_eq!(pm.base.m_f, 0.35, "the other parameters come from the file");
+        }
+        _ => panic!("materials[1] is not paper"),
+    }
+    // Out of range in the file: named with the file's line.
+    std::fs::write(
+        dir.path().join("paper.json"),
+        good.replace("\"m_b\": 0.35", "\"m_b\": 3.5"),
+    )
+    .unwrap();
+    let m = load_err(dir.path(), &scene);
+    contains_all(&m, &["materials.sheet", "params", "paper.json", "m_b", "3.5"]);
+    // An unknown key in the file.
+    std::fs::write(dir.path().join("paper.json"), good.replace("\"w_b\"", "\"wb\"")).unwrap();
+    let m = load_err(dir.path(), &scene);
+    contains_all(&m, &["materials.sheet", "paper.json", "wb"]);
+    // A missing file.
+    let m = load_err(dir.path(), &scene.replace("paper.json", "nowhere.json"));
+    contains_all(&m, &["materials.sheet", "nowhere.json"]);
+    // Both a preset and a file.
+    let m = load_err(dir.path(), &scene.replace("d = 0.2", "preset = \"matte\""));
+    contains_all(&m, &["materials.sheet", "preset", "params"]);
+}
