@@ -94,7 +94,13 @@ impl Microfacet {
 
     /// Smith's `Lambda(w)` (exact for both families).
     pub fn lambda(&self, w: DVec3) -> f64 {
-        let c2 = w.z * w.z;
+        self.lambda_cos(w.z)
+    }
+
+    /// Smith's `Lambda` of a direction with cosine `c` to the macro normal
+    /// (it depends on nothing else for these isotropic distributions).
+    pub fn lambda_cos(&self, c: f64) -> f64 {
+        let c2 = c * c;
         let s2 = (1.0 - c2).max(0.0);
         if s2 == 0.0 {
             return 0.0;
@@ -105,15 +111,7 @@ impl Microfacet {
         let tan2_a2 = self.alpha * self.alpha * s2 / c2;
         match self.dist {
             Distribution::Ggx => 0.5 * ((1.0 + tan2_a2).sqrt() - 1.0),
-            Distribution::Beckmann => {
-                let a = 1.0 / tan2_a2.sqrt();
-                if a >= 6.0 {
-                    // Both terms are below 2e-17 (erfc(6) = 2.2e-17): Lambda
-                    // is 0 to double precision against the 1 of G1 = 1/(1 + Lambda).
-                    return 0.0;
-                }
-                0.5 * (libm::erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * PI.sqrt())
-            }
+            Distribution::Beckmann => beckmann_lambda_a(1.0 / tan2_a2.sqrt()),
         }
     }
 
@@ -160,42 +158,37 @@ impl Microfacet {
     /// `G1(w) / w.z = 2 / (w.z + sqrt(alpha^2 + (1 - alpha^2) w.z^2))`.
     #[inline]
     pub fn reflection_dg(&self, wi: DVec3, wo: DVec3, h: DVec3) -> f64 {
-        let c = h.z;
-        if c <= 0.0 || wi.z <= 0.0 || wo.z <= 0.0 {
+        if h.z <= 0.0 {
             return 0.0;
         }
-        let c2 = c * c;
-        let a2 = self.alpha * self.alpha;
-        match self.dist {
-            Distribution::Ggx => {
-                let t = c2 * (a2 - 1.0) + 1.0;
-                let (ci, co) = (wi.z.min(1.0), wo.z.min(1.0));
-                let si = (a2 + (1.0 - a2) * ci * ci).sqrt();
-                let so = (a2 + (1.0 - a2) * co * co).sqrt();
-                a2 / (PI * t * t * (ci + si) * (co + so))
-            }
-            Distribution::Beckmann => {
-                let (d, g, den) = self.beckmann_parts(c, wi.z.min(1.0), wo.z.min(1.0));
-                d * g / (PI * a2 * den)
-            }
-        }
+        self.reflection_dg_pdf_c2(h.z * h.z, wi.z, wo.z).0
     }
 
     /// `(D G1(wi) G1(wo) / (4 wi.z wo.z), G1_exact(wo) D / (4 wo.z))`: the
     /// microfacet part of the reflection BRDF ([`Microfacet::reflection_dg`])
     /// and the density, per steradian of `wi`, with which reflecting `wo` on
     /// visible normals draws `wi` ([`Microfacet::pdf_visible`] over `4 wo.h`),
-    /// for `wi`, `wo` above the surface and their unit half vector `h`; shares
-    /// `D` and the masking of `wo` between the two, with few divisions.
+    /// for `wi`, `wo` above the surface and their unit half vector `h`.
     #[inline]
     pub fn reflection_dg_pdf(&self, wi: DVec3, wo: DVec3, h: DVec3) -> (f64, f64) {
-        let c = h.z;
-        if c <= 0.0 || wi.z <= 0.0 || wo.z <= 0.0 {
+        if h.z <= 0.0 {
             return (0.0, 0.0);
         }
-        let c2 = c * c;
+        self.reflection_dg_pdf_c2(h.z * h.z, wi.z, wo.z)
+    }
+
+    /// [`Microfacet::reflection_dg_pdf`] from `c2 = h.z^2` and the cosines
+    /// `ci = wi.z`, `co = wo.z` alone (for reflection nothing else of `h` is
+    /// needed, and `c2 = (ci + co)^2 / (2 (1 + wi.wo))` needs no square root).
+    /// Shares `D` and the masking of `wo` between the two, with few divisions.
+    #[inline]
+    pub fn reflection_dg_pdf_c2(&self, c2: f64, ci: f64, co: f64) -> (f64, f64) {
+        if c2 <= 0.0 || ci <= 0.0 || co <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let c2 = c2.min(1.0);
         let a2 = self.alpha * self.alpha;
-        let (ci, co) = (wi.z.min(1.0), wo.z.min(1.0));
+        let (ci, co) = (ci.min(1.0), co.min(1.0));
         match self.dist {
             Distribution::Ggx => {
                 let t = c2 * (a2 - 1.0) + 1.0;
@@ -207,12 +200,15 @@ impl Microfacet {
                 (dg, 0.5 * dg * (ci + si))
             }
             Distribution::Beckmann => {
-                let (d, g, den) = self.beckmann_parts(c, ci, co);
+                let (d, g, den, ao) = self.beckmann_parts(c2, ci, co);
                 if d == 0.0 {
                     return (0.0, 0.0);
                 }
                 let pi_a2 = PI * a2;
-                (d * g / (pi_a2 * den), d / (pi_a2 * 4.0 * co * (1.0 + self.lambda(wo))))
+                (
+                    d * g / (pi_a2 * den),
+                    d / (pi_a2 * 4.0 * co * (1.0 + beckmann_lambda_a(ao))),
+                )
             }
         }
     }
@@ -223,35 +219,44 @@ impl Microfacet {
     /// [`Microfacet::g1`] for such a direction.
     #[inline]
     fn beckmann_g1_ratio(&self, c: f64) -> (f64, f64) {
+        let (n, q, _) = self.beckmann_g1_ratio_a(c);
+        (n, q)
+    }
+
+    /// [`Microfacet::beckmann_g1_ratio`] and the `a = cot(theta) / alpha` it
+    /// used (infinite at normal incidence), which also gives Lambda
+    /// ([`beckmann_lambda_a`]).
+    #[inline]
+    fn beckmann_g1_ratio_a(&self, c: f64) -> (f64, f64, f64) {
         let s2 = (1.0 - c * c).max(0.0);
         if s2 == 0.0 {
-            return (1.0, 1.0);
+            return (1.0, 1.0, f64::INFINITY);
         }
         let a = c / (self.alpha * s2.sqrt());
         if a >= 1.6 {
-            (1.0, 1.0)
+            (1.0, 1.0, a)
         } else {
-            (3.535 * a + 2.181 * a * a, 1.0 + 2.276 * a + 2.577 * a * a)
+            (3.535 * a + 2.181 * a * a, 1.0 + 2.276 * a + 2.577 * a * a, a)
         }
     }
 
-    /// Beckmann parts for `h.z = c > 0` and cosines `ci`, `co` in `(0, 1]`:
-    /// `(pi alpha^2 D(h), N, Q)` with `G1(wi) G1(wo) / (4 ci co) = N / Q` (Walter's
-    /// rational `G1`), the same quantities as [`Microfacet::d`] and
-    /// [`Microfacet::g1`], left for the caller to divide once.
+    /// Beckmann parts for `c2 = h.z^2 > 0` and cosines `ci`, `co` in `(0, 1]`:
+    /// `(pi alpha^2 D(h), N, Q, a_o)` with `G1(wi) G1(wo) / (4 ci co) = N / Q`
+    /// (Walter's rational `G1`) and `a_o = cot(theta_o) / alpha`, the same
+    /// quantities as [`Microfacet::d`] and [`Microfacet::g1`], left for the
+    /// caller to divide once.
     #[inline]
-    fn beckmann_parts(&self, c: f64, ci: f64, co: f64) -> (f64, f64, f64) {
-        let c2 = c * c;
+    fn beckmann_parts(&self, c2: f64, ci: f64, co: f64) -> (f64, f64, f64, f64) {
         let a2 = self.alpha * self.alpha;
         let inv_c2 = 1.0 / c2;
         let e = (-(1.0 - c2).max(0.0) * inv_c2 / a2).exp();
         if e == 0.0 {
             // At extreme grazing both factors of D underflow: the limit is 0.
-            return (0.0, 1.0, 1.0);
+            return (0.0, 1.0, 1.0, f64::INFINITY);
         }
         let (ni, qi) = self.beckmann_g1_ratio(ci);
-        let (no, qo) = self.beckmann_g1_ratio(co);
-        (e * inv_c2 * inv_c2, ni * no, 4.0 * ci * co * qi * qo)
+        let (no, qo, ao) = self.beckmann_g1_ratio_a(co);
+        (e * inv_c2 * inv_c2, ni * no, 4.0 * ci * co * qi * qo, ao)
     }
 
     /// Separable Smith shadowing-masking `G1(wi, h) G1(wo, h)`.
@@ -315,6 +320,18 @@ impl Microfacet {
     pub fn beckmann_visible_frame(&self, w: DVec3) -> BeckmannVisibleFrame {
         BeckmannVisibleFrame::new(self.alpha, if w.z < 0.0 { -w } else { w })
     }
+}
+
+/// Beckmann's exact Smith `Lambda` for `a = cot(theta) / alpha > 0`:
+/// `(erf(a) - 1) / 2 + exp(-a^2) / (2 a sqrt(pi))`.
+#[inline]
+fn beckmann_lambda_a(a: f64) -> f64 {
+    if a >= 6.0 {
+        // Both terms are below 2e-17 (erfc(6) = 2.2e-17): Lambda is 0 to
+        // double precision against the 1 of G1 = 1/(1 + Lambda).
+        return 0.0;
+    }
+    0.5 * (libm::erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * PI.sqrt())
 }
 
 /// The stretched frame of Beckmann visible-normal sampling for one direction

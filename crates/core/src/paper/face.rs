@@ -31,6 +31,24 @@ pub(crate) fn to_face_frame(w: DVec3, side: usize) -> DVec3 {
     }
 }
 
+/// For `wi`, `wo` both above a face: `(h.z^2, wo.h)` of their unit half
+/// vector `h = (wi + wo) / |wi + wo|`, without forming it: `|wi + wo|^2 =
+/// 2 (1 + wi.wo)`, so `h.z^2 = (wi.z + wo.z)^2 / (2 (1 + wi.wo))` and
+/// `wo.h = wi.h = sqrt((1 + wi.wo) / 2)` (both see the front of `h`). `None`
+/// below the face or for opposite directions.
+#[inline]
+fn reflection_half(wi: DVec3, wo: DVec3) -> Option<(f64, f64)> {
+    if wi.z <= 0.0 || wo.z <= 0.0 {
+        return None;
+    }
+    let k = 1.0 + wi.dot(wo);
+    if k <= 0.0 || !k.is_finite() {
+        return None;
+    }
+    let zs = wi.z + wo.z;
+    Some((zs * zs / (2.0 * k), (0.5 * k).sqrt().min(1.0)))
+}
+
 /// A face of the slab with its precomputed integrals.
 #[derive(Clone, Debug)]
 pub(crate) struct Face {
@@ -224,18 +242,10 @@ impl Face {
         let Interface::Rough(mf) = self.bd.interface else {
             return 0.0;
         };
-        if wi.z <= 0.0 || wo.z <= 0.0 {
+        let Some((c2, oh)) = reflection_half(wi, wo) else {
             return 0.0;
-        }
-        let h = wi + wo;
-        let hl = h.length();
-        if hl == 0.0 || !hl.is_finite() {
-            return 0.0;
-        }
-        let h = h / hl;
-        // Both directions are above the face, so both see the front of `h`
-        // (`w.h = (1 + wi.wo) / |wi + wo| >= 0`).
-        fresnel_dielectric(wo.dot(h), self.bd.eta) * mf.reflection_dg(wi, wo, h)
+        };
+        fresnel_dielectric(oh, self.bd.eta) * mf.reflection_dg_pdf_c2(c2, wi.z, wo.z).0
     }
 
     /// Density of [`Face::sample_reflection`]: `pdf_visible(wo, h) / (4 |wo.h|)`.
@@ -265,17 +275,11 @@ impl Face {
         let Interface::Rough(mf) = self.bd.interface else {
             return (0.0, 0.0);
         };
-        if wi.z <= 0.0 || wo.z <= 0.0 {
+        let Some((c2, oh)) = reflection_half(wi, wo) else {
             return (0.0, 0.0);
-        }
-        let h = wi + wo;
-        let hl = h.length();
-        if hl == 0.0 || !hl.is_finite() {
-            return (0.0, 0.0);
-        }
-        let h = h / hl;
-        let (dg, pdf) = mf.reflection_dg_pdf(wi, wo, h);
-        (fresnel_dielectric(wo.dot(h), self.bd.eta) * dg, pdf)
+        };
+        let (dg, pdf) = mf.reflection_dg_pdf_c2(c2, wi.z, wo.z);
+        (fresnel_dielectric(oh, self.bd.eta) * dg, pdf)
     }
 
     /// Draws a reflected `wi` (face frame) from the visible normals seen from `wo`.

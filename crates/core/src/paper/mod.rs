@@ -236,7 +236,9 @@ fn side(w: DVec3) -> usize {
 struct Inside {
     mu_i: f64,
     mu_o: f64,
-    p: f64,
+    /// The phase function as `p_num / p_den` (`p_num = 0`, `p_den = 1` if not asked).
+    p_num: f64,
+    p_den: f64,
 }
 
 /// The Paper BSDF (module doc). Build with [`PaperBsdf::new`] or [`PaperBsdf::reduced_multilayer`].
@@ -549,15 +551,16 @@ impl PaperBsdf {
         lerp_tab(&self.ess_tab[face.min(1)], mu)
     }
 
-    /// The mixture phase function (non-degenerate lobes) at cosine `cos`.
+    /// The mixture phase function (non-degenerate lobes) at cosine `cos`, as
+    /// `(numerator, denominator)` for callers that fold the division into their own: `w HG(cos; g) = k / (q sqrt(q))`,
+    /// `q = 1 + g^2 - 2 g cos`, both lobes over one denominator (an absent lobe
+    /// has `k = 0` and `q = 1`).
     #[inline]
-    fn phase(&self, cos: f64) -> f64 {
-        // w HG(cos; g) = k / (q sqrt(q)), q = 1 + g^2 - 2 g cos: both lobes
-        // with one division (an absent lobe has k = 0 and q = 1).
+    fn phase_ratio(&self, cos: f64) -> (f64, f64) {
         let [(k0, a0, b0), (k1, a1, b1)] = self.lobe_hg;
         let (q0, q1) = (a0 - b0 * cos, a1 - b1 * cos);
         let (d0, d1) = (q0 * q0.sqrt(), q1 * q1.sqrt());
-        (k0 * d1 + k1 * d0) / (d0 * d1)
+        (k0 * d1 + k1 * d0, d0 * d1)
     }
 
     /// Inside propagation directions `(t_i, t_o)` and cosines for outside `wi`, `wo`.
@@ -576,12 +579,17 @@ impl PaperBsdf {
     #[inline]
     fn inside(&self, wi: DVec3, wo: DVec3, want_phase: bool) -> Inside {
         let (t_i, t_o, mu_i, mu_o) = self.inside_dirs(wi, wo);
-        let p = if want_phase && self.lobe_sum > 0.0 {
-            self.phase(t_i.dot(t_o).clamp(-1.0, 1.0))
+        let (p_num, p_den) = if want_phase && self.lobe_sum > 0.0 {
+            self.phase_ratio(t_i.dot(t_o).clamp(-1.0, 1.0))
         } else {
-            0.0
+            (0.0, 1.0)
         };
-        Inside { mu_i, mu_o, p }
+        Inside {
+            mu_i,
+            mu_o,
+            p_num,
+            p_den,
+        }
     }
 
     /// Sum of the components in `set` (no cosine; delta lobes excluded).
@@ -626,31 +634,30 @@ impl PaperBsdf {
         if mu_i <= 0.0 || mu_o <= 0.0 {
             return out;
         }
-        if set.contains(Component::Single) && self.lobe_sum > 0.0 {
-            let p = g.p;
-            if p > 0.0 {
-                let k = att * p * fx.inv_eta2();
-                if reflect && self.tau_min * (mu_i + mu_o) > 40.0 * mu_i * mu_o {
-                    // tau (1/mu_i + 1/mu_o) > 40 in every channel: the
-                    // exponential is below 4e-18 of 1; skip it (thick paper).
-                    out += self.albedo * (k / (mu_i + mu_o));
-                } else if !reflect && self.tau_min > 40.0 * mu_i.max(mu_o) {
-                    // Both paths through the sheet are attenuated by more
-                    // than e^{-40}: dropped like the direct term below.
-                } else {
-                    let depth = |tau: f64| {
-                        if reflect {
-                            single::depth_reflection(tau, mu_i, mu_o)
-                        } else {
-                            single::depth_transmission(tau, mu_i, mu_o)
-                        }
-                    };
-                    if self.grey {
-                        out += Rgb::splat(k * self.albedo.0[0] * depth(self.tau.0[0]));
+        if set.contains(Component::Single) && self.lobe_sum > 0.0 && g.p_num > 0.0 {
+            let ka = att * g.p_num * fx.inv_eta2();
+            if reflect && self.tau_min * (mu_i + mu_o) > 40.0 * mu_i * mu_o {
+                // tau (1/mu_i + 1/mu_o) > 40 in every channel: the
+                // exponential is below 4e-18 of 1; skip it (thick paper).
+                // One division for the phase function and the depth integral.
+                out += self.albedo * (ka / (g.p_den * (mu_i + mu_o)));
+            } else if !reflect && self.tau_min > 40.0 * mu_i.max(mu_o) {
+                // Both paths through the sheet are attenuated by more
+                // than e^{-40}: dropped like the direct term below.
+            } else {
+                let k = ka / g.p_den;
+                let depth = |tau: f64| {
+                    if reflect {
+                        single::depth_reflection(tau, mu_i, mu_o)
                     } else {
-                        for c in 0..3 {
-                            out.0[c] += k * self.albedo.0[c] * depth(self.tau.0[c]);
-                        }
+                        single::depth_transmission(tau, mu_i, mu_o)
+                    }
+                };
+                if self.grey {
+                    out += Rgb::splat(k * self.albedo.0[0] * depth(self.tau.0[0]));
+                } else {
+                    for c in 0..3 {
+                        out.0[c] += k * self.albedo.0[c] * depth(self.tau.0[c]);
                     }
                 }
             }
@@ -727,6 +734,19 @@ impl PaperBsdf {
     /// Lobe selection probabilities for viewer `wo`: surface, single, multiple R,
     /// multiple T, direct (normalised; all zero if nothing can be sampled).
     fn lobe_probs(&self, wo: DVec3) -> [f64; 5] {
+        let (w, sum) = self.lobe_weights(wo);
+        if sum > 0.0 {
+            let inv = 1.0 / sum;
+            w.map(|v| v * inv)
+        } else {
+            [0.0; 5]
+        }
+    }
+
+    /// The unnormalised weights of [`PaperBsdf::lobe_probs`] and their sum (0
+    /// if nothing can be sampled): `sample` selects with them directly, so that
+    /// the normalising division is off the path to the sampled direction.
+    fn lobe_weights(&self, wo: DVec3) -> ([f64; 5], f64) {
         let x = side(wo);
         let ot = 1 - x;
         let (fx, fo) = (&self.faces[x], &self.faces[ot]);
@@ -766,10 +786,9 @@ impl PaperBsdf {
         }
         let sum: f64 = w.iter().sum();
         if !sum.is_finite() || sum <= 0.0 {
-            return [0.0; 5];
+            return ([0.0; 5], 0.0);
         }
-        let inv = 1.0 / sum;
-        w.map(|v| v * inv)
+        (w, sum)
     }
 
     /// Density of the single-scattering strategy: the phase function around
@@ -779,7 +798,7 @@ impl PaperBsdf {
         if g.mu_i <= 0.0 || self.lobe_sum <= 0.0 {
             return 0.0;
         }
-        g.p * wi.z.abs() * self.faces[side(wi)].inv_eta2() / (self.lobe_sum * g.mu_i)
+        g.p_num * wi.z.abs() * self.faces[side(wi)].inv_eta2() / (g.p_den * self.lobe_sum * g.mu_i)
     }
 
     fn pdf_with(&self, wi: DVec3, wo: DVec3, pr: &[f64; 5], pre: Option<&Inside>) -> f64 {
@@ -829,16 +848,24 @@ impl Bsdf for PaperBsdf {
         if grazing(wo) || !wo.is_finite() {
             return None;
         }
-        let pr = self.lobe_probs(wo);
-        let mut k = 0;
-        let mut acc = 0.0;
-        while k < 4 && uc >= acc + pr[k] {
-            acc += pr[k];
-            k += 1;
-        }
-        if pr[k] <= 0.0 {
+        let (wts, sum) = self.lobe_weights(wo);
+        if sum <= 0.0 {
             return None;
         }
+        // Select on the unnormalised weights; the probabilities for the
+        // mixture pdf are computed alongside.
+        let target = uc * sum;
+        let mut k = 0;
+        let mut acc = 0.0;
+        while k < 4 && target >= acc + wts[k] {
+            acc += wts[k];
+            k += 1;
+        }
+        if wts[k] <= 0.0 {
+            return None;
+        }
+        let inv_sum = 1.0 / sum;
+        let pr = wts.map(|v| v * inv_sum);
         let x = side(wo);
         let sx = if x == 0 { 1.0 } else { -1.0 };
         let wi = match k {
@@ -861,7 +888,7 @@ impl Bsdf for PaperBsdf {
                 let mu_o = fx.inside_cos(wo.z.abs());
                 let t_o = DVec3::new(wo.x / fx.eta(), wo.y / fx.eta(), sx * mu_o).normalize();
                 // Reuse the lobe-choice number to pick the HG lobe.
-                let ucr = ((uc - acc) / pr[k]).clamp(0.0, 1.0 - 1e-16);
+                let ucr = ((target - acc) / wts[k]).clamp(0.0, 1.0 - 1e-16);
                 let g = if ucr * self.lobe_sum < self.lobes[0].1 {
                     self.lobes[0].0
                 } else {
