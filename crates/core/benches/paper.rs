@@ -34,6 +34,38 @@ fn bench(c: &mut Criterion) {
                 black_box(&b).sample(black_box(wo), u0, [(u0 * 7.31).fract(), (u0 * 13.7).fract()])
             })
         });
+        // A renderer-like workload: 1024 cosine-distributed viewer directions
+        // with light directions on the same side (reflection) or the other
+        // (transmission), cycled, so that the inputs come from memory and the
+        // branches see varied directions (as at the vertices of a path tracer).
+        let pairs: Vec<(DVec3, DVec3)> = (0..1024u32)
+            .map(|k| {
+                let r = |j: u32| ((k.wrapping_mul(2_654_435_761).wrapping_add(j * 40_503)) % 65_521) as f64 / 65_521.0;
+                let wo = paperbsdf_core::geometry::sample_cosine_hemisphere([r(1), r(2)]);
+                let wi = paperbsdf_core::geometry::sample_cosine_hemisphere([r(3), r(4)]);
+                (wi, wo)
+            })
+            .collect();
+        for (kind, sign) in [("reflection", 1.0), ("transmission", -1.0)] {
+            let mut i = 0usize;
+            c.bench_function(&format!("paper/{name}/eval_{kind}_varied"), |bn| {
+                bn.iter(|| {
+                    i = (i + 1) & 1023;
+                    let (wi, wo) = pairs[i];
+                    black_box(&b).eval(DVec3::new(wi.x, wi.y, sign * wi.z), wo)
+                })
+            });
+        }
+        let mut i = 0usize;
+        let mut k = 0u64;
+        c.bench_function(&format!("paper/{name}/sample_varied"), |bn| {
+            bn.iter(|| {
+                i = (i + 1) & 1023;
+                k = k.wrapping_add(0x9E37_79B9_7F4A_7C15);
+                let u0 = (k >> 11) as f64 / (1u64 << 53) as f64;
+                black_box(&b).sample(pairs[i].1, u0, [(u0 * 7.31).fract(), (u0 * 13.7).fract()])
+            })
+        });
         c.bench_function(&format!("paper/{name}/build"), |bn| {
             bn.iter(|| PaperBsdf::new(black_box(&p)).unwrap())
         });

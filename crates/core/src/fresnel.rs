@@ -26,7 +26,15 @@ pub fn fresnel_dielectric(cos_i: f64, eta: f64) -> f64 {
     if cos_i == 0.0 {
         return 1.0;
     }
-    let cos_t = (1.0 - sin2_t).sqrt();
+    fresnel_from_cosines(cos_i, (1.0 - sin2_t).sqrt(), eta_it)
+}
+
+/// The unpolarised reflectance `(r_s^2 + r_p^2) / 2` from the cosines of the
+/// incident and transmitted directions (`cos_i > 0`, `cos_t >= 0`) and the
+/// index ratio `eta_it` (transmitted over incident side): the last step of
+/// [`fresnel_dielectric`], for callers that have `cos_t` already.
+#[inline]
+pub fn fresnel_from_cosines(cos_i: f64, cos_t: f64, eta_it: f64) -> f64 {
     // r_s = n_s / d_s, r_p = n_p / d_p, summed over one division.
     let (n_s, d_s) = (cos_i - eta_it * cos_t, cos_i + eta_it * cos_t);
     let (n_p, d_p) = (cos_t - eta_it * cos_i, cos_t + eta_it * cos_i);

@@ -196,6 +196,18 @@ impl Face {
         self.si.rho_in
     }
 
+    /// [`fresnel_dielectric`] for light from outside at cosine `c` in `(0, 1]`
+    /// (`eta >= 1`: no total internal reflection), with the face's `1 / eta^2`
+    /// in place of a division.
+    #[inline]
+    pub fn fresnel_outside(&self, c: f64) -> f64 {
+        if self.bd.eta == 1.0 {
+            return 0.0;
+        }
+        let cos_t = (1.0 - (1.0 - c * c) * self.inv_eta2).max(0.0).sqrt();
+        crate::fresnel::fresnel_from_cosines(c, cos_t, self.bd.eta)
+    }
+
     /// `1 / eta`.
     #[inline]
     pub fn inv_eta(&self) -> f64 {
@@ -245,7 +257,7 @@ impl Face {
         let Some((c2, oh)) = reflection_half(wi, wo) else {
             return 0.0;
         };
-        fresnel_dielectric(oh, self.bd.eta) * mf.reflection_dg_pdf_c2(c2, wi.z, wo.z).0
+        self.fresnel_outside(oh) * mf.reflection_dg_c2(c2, wi.z, wo.z)
     }
 
     /// Density of [`Face::sample_reflection`]: `pdf_visible(wo, h) / (4 |wo.h|)`.
@@ -279,7 +291,7 @@ impl Face {
             return (0.0, 0.0);
         };
         let (dg, pdf) = mf.reflection_dg_pdf_c2(c2, wi.z, wo.z);
-        (fresnel_dielectric(oh, self.bd.eta) * dg, pdf)
+        (self.fresnel_outside(oh) * dg, pdf)
     }
 
     /// Draws a reflected `wi` (face frame) from the visible normals seen from `wo`.

@@ -168,6 +168,8 @@ impl Default for PaperOptions {
     }
 }
 
+/// Nodes of the lobe-probability table in the outside cosine (`mu = t^2`, `t` uniform).
+const NP: usize = 33;
 /// Number of nodes of the per-face tables in the outside cosine (`mu = t^2`, `t` uniform).
 const NS: usize = 17;
 /// Gauss-Legendre points per part of the single-scattering albedo quadrature
@@ -265,6 +267,8 @@ pub struct PaperBsdf {
     /// Per face of exit: whether the single, multiple-reflection and
     /// multiple-transmission lobes carry any light.
     lobe_present: [[bool; 3]; 2],
+    /// Per face of exit and node of [`NP`]: the lobe probabilities of [`PaperBsdf::lobe_probs`].
+    pr_tab: [[[f64; 5]; NP]; 2],
     kernel: SheetKernel,
     opts: PaperOptions,
     is_rgb: bool,
@@ -346,6 +350,7 @@ impl PaperBsdf {
             ess_tab: [[Rgb::ZERO; NS]; 2],
             lobe_tab: [[[0.0; 3]; NS]; 2],
             lobe_present: [[false; 3]; 2],
+            pr_tab: [[[0.0; 5]; NP]; 2],
             kernel,
             opts,
             is_rgb: p.is_rgb(),
@@ -396,6 +401,16 @@ impl PaperBsdf {
                     (me.c_r[x] * s).mean() * PI * abar_x,
                     (me.c_t[x] * s).mean() * PI * abar_o,
                 ];
+            }
+        }
+        for x in 0..2 {
+            let sign = if x == 0 { 1.0 } else { -1.0 };
+            for k in 0..NP {
+                let t = k as f64 / (NP - 1) as f64;
+                // The node at grazing is taken just above the sheet's plane.
+                let mu = (t * t).max(1e-6);
+                let wo = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, sign * mu);
+                me.pr_tab[x][k] = me.lobe_probs_exact(wo);
             }
         }
         Ok(me)
@@ -733,20 +748,27 @@ impl PaperBsdf {
 
     /// Lobe selection probabilities for viewer `wo`: surface, single, multiple R,
     /// multiple T, direct (normalised; all zero if nothing can be sampled).
+    ///
+    /// They depend on the face and `|wo.z|` only and are tabulated at
+    /// construction ([`PaperBsdf::lobe_probs_exact`] on [`NP`] nodes in
+    /// `sqrt(|wo.z|)`) and interpolated: a convex combination of probability
+    /// vectors, so they still sum to 1, and `sample` and `pdf` use the same
+    /// values, so the mixture density is exactly that of the sampler. (They are
+    /// only a choice of strategy weights: any positive values would be unbiased.)
+    #[inline]
     fn lobe_probs(&self, wo: DVec3) -> [f64; 5] {
-        let (w, sum) = self.lobe_weights(wo);
-        if sum > 0.0 {
-            let inv = 1.0 / sum;
-            w.map(|v| v * inv)
-        } else {
-            [0.0; 5]
-        }
+        let st = wo.z.abs().min(1.0).sqrt();
+        let xs = st * (NP - 1) as f64;
+        let i = (xs as usize).min(NP - 2);
+        let f = xs - i as f64;
+        let tab = &self.pr_tab[side(wo)];
+        let (a, b) = (&tab[i], &tab[i + 1]);
+        std::array::from_fn(|k| a[k] * (1.0 - f) + b[k] * f)
     }
 
-    /// The unnormalised weights of [`PaperBsdf::lobe_probs`] and their sum (0
-    /// if nothing can be sampled): `sample` selects with them directly, so that
-    /// the normalising division is off the path to the sampled direction.
-    fn lobe_weights(&self, wo: DVec3) -> ([f64; 5], f64) {
+    /// The lobe probabilities of [`PaperBsdf::lobe_probs`] computed from the
+    /// albedo estimates for viewer `wo` (the table's nodes).
+    fn lobe_probs_exact(&self, wo: DVec3) -> [f64; 5] {
         let x = side(wo);
         let ot = 1 - x;
         let (fx, fo) = (&self.faces[x], &self.faces[ot]);
@@ -786,9 +808,9 @@ impl PaperBsdf {
         }
         let sum: f64 = w.iter().sum();
         if !sum.is_finite() || sum <= 0.0 {
-            return ([0.0; 5], 0.0);
+            return [0.0; 5];
         }
-        (w, sum)
+        w.map(|v| v / sum)
     }
 
     /// Density of the single-scattering strategy: the phase function around
@@ -848,24 +870,16 @@ impl Bsdf for PaperBsdf {
         if grazing(wo) || !wo.is_finite() {
             return None;
         }
-        let (wts, sum) = self.lobe_weights(wo);
-        if sum <= 0.0 {
-            return None;
-        }
-        // Select on the unnormalised weights; the probabilities for the
-        // mixture pdf are computed alongside.
-        let target = uc * sum;
+        let pr = self.lobe_probs(wo);
         let mut k = 0;
         let mut acc = 0.0;
-        while k < 4 && target >= acc + wts[k] {
-            acc += wts[k];
+        while k < 4 && uc >= acc + pr[k] {
+            acc += pr[k];
             k += 1;
         }
-        if wts[k] <= 0.0 {
+        if pr[k] <= 0.0 {
             return None;
         }
-        let inv_sum = 1.0 / sum;
-        let pr = wts.map(|v| v * inv_sum);
         let x = side(wo);
         let sx = if x == 0 { 1.0 } else { -1.0 };
         let wi = match k {
@@ -888,7 +902,7 @@ impl Bsdf for PaperBsdf {
                 let mu_o = fx.inside_cos(wo.z.abs());
                 let t_o = DVec3::new(wo.x / fx.eta(), wo.y / fx.eta(), sx * mu_o).normalize();
                 // Reuse the lobe-choice number to pick the HG lobe.
-                let ucr = ((target - acc) / wts[k]).clamp(0.0, 1.0 - 1e-16);
+                let ucr = ((uc - acc) / pr[k]).clamp(0.0, 1.0 - 1e-16);
                 let g = if ucr * self.lobe_sum < self.lobes[0].1 {
                     self.lobes[0].0
                 } else {
