@@ -13,6 +13,9 @@
 //!    `paperbsdf albedo` uses (`paperbsdf_core::bsdf::sampled_albedo`, 512 x
 //!    512 stratified samples). The single-scattering microfacet faces lose
 //!    energy, so `R + T < 1`, and that is what the render must reproduce.
+//! 3. The same with a thickness map and with an ink map: the render must be
+//!    the albedo of the mapped parameters, which differs from the unmapped
+//!    sheet's by far more than the tolerance.
 //!
 //! Tolerances are in standard errors of the render, from the per-pixel sample
 //! variance (`Film::var_of_mean`); a block's or the image's standard error is
@@ -165,6 +168,21 @@ transform = [{{ scale = 0.4 }}, {{ rotate = [0, 0, 1], angle = 30 }}, {{ transla
 /// uniform environment of radiance 1 from `origin`, and compares every pixel
 /// with the model's directional albedo for that pixel's view direction.
 fn paper_sheet_furnace(preset: &str, origin: [f64; 3]) {
+    let p = presets::preset(preset).unwrap();
+    paper_sheet_furnace_with(&format!("preset = \"{preset}\""), &p, preset, origin, Path::new("."));
+}
+
+/// [`paper_sheet_furnace`] for the material lines `material` (inside
+/// `[materials.sheet]`, after `type = "paper"`), whose BSDF everywhere on the
+/// sheet must be the Paper BSDF of `params`; `dir` holds the files it names.
+fn paper_sheet_furnace_with(
+    material: &str,
+    params: &paperbsdf_core::PaperParams,
+    label: &str,
+    origin: [f64; 3],
+    dir: &Path,
+) {
+    let preset = label;
     let text = format!(
         r#"
 [render]
@@ -183,7 +201,7 @@ radiance = 1
 
 [materials.sheet]
 type = "paper"
-preset = "{preset}"
+{material}
 
 [[shapes]]
 type = "rectangle"
@@ -192,9 +210,9 @@ transform = [{{ scale = [4, 4, 1] }}]
 "#,
         origin[0], origin[1], origin[2]
     );
-    let scene = load_scene_str(&text, "sheet.toml", &resources(Path::new("."))).unwrap();
+    let scene = load_scene_str(&text, "sheet.toml", &resources(dir)).unwrap();
     let film = render(&scene, 16384);
-    let bsdf = PaperBsdf::new(&presets::preset(preset).unwrap()).unwrap();
+    let bsdf = PaperBsdf::new(params).unwrap();
     let (w, h) = (film.width, film.height);
     let cam = &scene.camera;
     // Per pixel: the view direction at the pixel centre, in the sheet's frame
@@ -261,4 +279,74 @@ fn paper_sheet_furnace_matte_front() {
 fn paper_sheet_furnace_luster_front_and_back() {
     paper_sheet_furnace("luster", [0.0, -2.0, 2.0]);
     paper_sheet_furnace("luster", [0.0, -2.0, -2.0]);
+}
+
+/// Thickness and ink maps (DESIGN: a watermark is thinner paper, print is
+/// absorption): a sheet whose maps are black everywhere must render as the
+/// Paper BSDF of the mapped parameters, `d (min + (1 - min) 0)` and
+/// `sigma_a + ink (1 - 0)` (docs/scenes.md), not as the unmapped sheet. The
+/// parameters absorb enough (`sigma_a` 3/mm over 0.2 mm) that the albedo moves
+/// by far more than the tolerance when a map is applied: the test would fail
+/// if the maps were ignored, which is checked first.
+#[test]
+fn paper_sheet_furnace_with_thickness_and_ink_maps() {
+    let dir = tempfile::tempdir().unwrap();
+    image::GrayImage::from_pixel(2, 2, image::Luma([0u8]))
+        .save(dir.path().join("black.png"))
+        .unwrap();
+    let base = r#"d = 0.2
+sigma_a = 3.0
+sigma_s = 60.0
+g_f = 0.7
+g_b = -0.3
+w_b = 0.2
+eta_f = 1.5
+eta_b = 1.5
+m_f = 0.3
+m_b = 0.3
+dist_f = "ggx"
+dist_b = "ggx""#;
+    let params = |d: f64, sigma_a: f64| paperbsdf_core::PaperParams {
+        name: None,
+        d,
+        sigma_a: paperbsdf_core::Colour::Scalar(sigma_a),
+        sigma_s: paperbsdf_core::Colour::Scalar(60.0),
+        g_f: 0.7,
+        g_b: -0.3,
+        w_b: 0.2,
+        eta_f: 1.5,
+        eta_b: 1.5,
+        m_f: 0.3,
+        m_b: 0.3,
+        dist_f: paperbsdf_core::Distribution::Ggx,
+        dist_b: paperbsdf_core::Distribution::Ggx,
+    };
+    let wo = paperbsdf_core::DVec3::new(0.6, 0.0, 0.8);
+    let albedo = |p: &paperbsdf_core::PaperParams| {
+        let (r, t) = sampled_albedo(&PaperBsdf::new(p).unwrap(), wo, 512);
+        (r + t).0[0]
+    };
+    let (plain, thin, inked) = (
+        albedo(&params(0.2, 3.0)),
+        albedo(&params(0.05, 3.0)),
+        albedo(&params(0.2, 23.0)),
+    );
+    eprintln!(
+        "albedo R+T at 37 degrees: plain {plain:.4}, thickness map (d 0.05) {thin:.4}, ink map (sigma_a 23) {inked:.4}"
+    );
+    assert!((thin - plain).abs() > 0.05 && (inked - plain).abs() > 0.05);
+    paper_sheet_furnace_with(
+        &format!("{base}\nthickness_map = {{ file = \"black.png\", min = 0.25 }}"),
+        &params(0.05, 3.0),
+        "thickness map",
+        [0.0, -2.0, 2.0],
+        dir.path(),
+    );
+    paper_sheet_furnace_with(
+        &format!("{base}\nink_map = {{ file = \"black.png\", sigma_a = 20 }}"),
+        &params(0.2, 23.0),
+        "ink map",
+        [0.0, -2.0, 2.0],
+        dir.path(),
+    );
 }
