@@ -168,24 +168,8 @@ impl Microfacet {
     /// (see [`Microfacet::reflection_dg_pdf_c2`]), without the density.
     #[inline]
     pub fn reflection_dg_c2(&self, c2: f64, ci: f64, co: f64) -> f64 {
-        if c2 <= 0.0 || ci <= 0.0 || co <= 0.0 {
-            return 0.0;
-        }
-        let c2 = c2.min(1.0);
-        let a2 = self.alpha * self.alpha;
-        let (ci, co) = (ci.min(1.0), co.min(1.0));
-        match self.dist {
-            Distribution::Ggx => {
-                let t = c2 * (a2 - 1.0) + 1.0;
-                let si = (a2 + (1.0 - a2) * ci * ci).sqrt();
-                let so = (a2 + (1.0 - a2) * co * co).sqrt();
-                a2 / (PI * t * t * (ci + si) * (co + so))
-            }
-            Distribution::Beckmann => {
-                let (d, g, den, _) = self.beckmann_parts(c2, ci, co);
-                d * g / (PI * a2 * den)
-            }
-        }
+        // The density is dead code here and compiled away once inlined.
+        self.reflection_dg_pdf_c2(c2, ci, co).0
     }
 
     /// `(D G1(wi) G1(wo) / (4 wi.z wo.z), G1_exact(wo) D / (4 wo.z))`: the
