@@ -140,12 +140,8 @@ impl Microfacet {
         match self.dist {
             Distribution::Ggx => 2.0 / (1.0 + (1.0 + tan2_a2).sqrt()),
             Distribution::Beckmann => {
-                let a = 1.0 / tan2_a2.sqrt();
-                if a >= 1.6 {
-                    1.0
-                } else {
-                    (3.535 * a + 2.181 * a * a) / (1.0 + 2.276 * a + 2.577 * a * a)
-                }
+                let (n, q, _) = self.beckmann_g1_ratio(w.z.abs());
+                n / q
             }
         }
     }
@@ -223,19 +219,11 @@ impl Microfacet {
 
     /// Walter's rational Beckmann `G1` of a direction with cosine `c` above the
     /// surface (seeing the front of its micro-normal) as `(numerator,
-    /// denominator)`, so that callers can merge divisions. Equal to
-    /// [`Microfacet::g1`] for such a direction.
+    /// denominator, a)`, so that callers can merge divisions, with the
+    /// `a = cot(theta) / alpha` it used (infinite at normal incidence), which
+    /// also gives Lambda ([`beckmann_lambda_a`]).
     #[inline]
-    fn beckmann_g1_ratio(&self, c: f64) -> (f64, f64) {
-        let (n, q, _) = self.beckmann_g1_ratio_a(c);
-        (n, q)
-    }
-
-    /// [`Microfacet::beckmann_g1_ratio`] and the `a = cot(theta) / alpha` it
-    /// used (infinite at normal incidence), which also gives Lambda
-    /// ([`beckmann_lambda_a`]).
-    #[inline]
-    fn beckmann_g1_ratio_a(&self, c: f64) -> (f64, f64, f64) {
+    fn beckmann_g1_ratio(&self, c: f64) -> (f64, f64, f64) {
         let s2 = (1.0 - c * c).max(0.0);
         if s2 == 0.0 {
             return (1.0, 1.0, f64::INFINITY);
@@ -262,8 +250,8 @@ impl Microfacet {
             // At extreme grazing both factors of D underflow: the limit is 0.
             return (0.0, 1.0, 1.0, f64::INFINITY);
         }
-        let (ni, qi) = self.beckmann_g1_ratio(ci);
-        let (no, qo, ao) = self.beckmann_g1_ratio_a(co);
+        let (ni, qi, _) = self.beckmann_g1_ratio(ci);
+        let (no, qo, ao) = self.beckmann_g1_ratio(co);
         (e * inv_c2 * inv_c2, ni * no, 4.0 * ci * co * qi * qo, ao)
     }
 

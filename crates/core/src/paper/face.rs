@@ -264,24 +264,14 @@ impl Face {
     #[inline]
     pub fn reflection_pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
         let Some(mf) = self.microfacet() else { return 0.0 };
-        if wi.z <= 0.0 || wo.z <= 0.0 {
+        let Some((c2, _)) = reflection_half(wi, wo) else {
             return 0.0;
-        }
-        let h = wi + wo;
-        let hl = h.length();
-        if hl == 0.0 {
-            return 0.0;
-        }
-        let h = h / hl;
-        let oh = wo.dot(h);
-        if oh <= 0.0 {
-            return 0.0;
-        }
-        mf.pdf_visible(wo, h) / (4.0 * oh)
+        };
+        mf.reflection_dg_pdf_c2(c2, wi.z, wo.z).1
     }
 
     /// `(f_r, pdf)`: [`Face::reflection`] and [`Face::reflection_pdf`] at once,
-    /// sharing the half vector and `D(h)` (for `sample`, which needs both).
+    /// sharing `D(h)` and the masking of `wo` (for `sample`, which needs both).
     #[inline]
     pub fn reflection_and_pdf(&self, wi: DVec3, wo: DVec3) -> (f64, f64) {
         let Interface::Rough(mf) = self.bd.interface else {

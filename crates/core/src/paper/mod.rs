@@ -250,7 +250,7 @@ pub struct PaperBsdf {
     /// Non-degenerate HG lobes `(g, weight)`; a lobe with `|g| = 1` is a delta
     /// in direction and contributes nothing to `eval` (see [`PaperBsdf::new`]).
     lobes: [(f64, f64); 2],
-    /// Per lobe `(w (1 - g^2) / (4 pi), 1 + g^2, 2 g)`: [`PaperBsdf::phase`]'s constants.
+    /// Per lobe `(w (1 - g^2) / (4 pi), 1 + g^2, 2 g)`: [`PaperBsdf::phase_ratio`]'s constants.
     lobe_hg: [(f64, f64, f64); 2],
     lobe_sum: f64,
     albedo: Rgb,
@@ -260,13 +260,6 @@ pub struct PaperBsdf {
     ms_albedo: [Rgb; 2],
     s_tab: [[Rgb; NS]; 2],
     ess_tab: [[Rgb; NS]; 2],
-    /// Per face of exit and node of [`NS`]: the channel means of the single,
-    /// multiple-reflection and multiple-transmission albedo estimates that
-    /// [`PaperBsdf::lobe_probs`] weighs the lobes by (before the `Att` factor).
-    lobe_tab: [[[f64; 3]; NS]; 2],
-    /// Per face of exit: whether the single, multiple-reflection and
-    /// multiple-transmission lobes carry any light.
-    lobe_present: [[bool; 3]; 2],
     /// Per face of exit and node of [`NP`]: the lobe probabilities of [`PaperBsdf::lobe_probs`].
     pr_tab: [[[f64; 5]; NP]; 2],
     kernel: SheetKernel,
@@ -348,8 +341,6 @@ impl PaperBsdf {
             ms_albedo: [Rgb::ZERO; 2],
             s_tab: [[Rgb::ONE; NS]; 2],
             ess_tab: [[Rgb::ZERO; NS]; 2],
-            lobe_tab: [[[0.0; 3]; NS]; 2],
-            lobe_present: [[false; 3]; 2],
             pr_tab: [[[0.0; 5]; NP]; 2],
             kernel,
             opts,
@@ -387,22 +378,6 @@ impl PaperBsdf {
             me.ms_albedo[e] = me.c_r[e] * (PI * fe.abar) + me.c_t[e] * (PI * fx.abar);
         }
         me.build_tables(symmetric);
-        for x in 0..2 {
-            me.lobe_present[x] = [
-                me.lobe_sum > 0.0 && me.albedo.max_channel() > 0.0,
-                me.c_r[x].max_channel() > 0.0,
-                me.c_t[x].max_channel() > 0.0,
-            ];
-            let (abar_x, abar_o) = (me.faces[x].abar, me.faces[1 - x].abar);
-            for k in 0..NS {
-                let s = if opts.energy_bound { me.s_tab[x][k] } else { Rgb::ONE };
-                me.lobe_tab[x][k] = [
-                    me.ess_tab[x][k].mean(),
-                    (me.c_r[x] * s).mean() * PI * abar_x,
-                    (me.c_t[x] * s).mean() * PI * abar_o,
-                ];
-            }
-        }
         for x in 0..2 {
             let sign = if x == 0 { 1.0 } else { -1.0 };
             for k in 0..NP {
@@ -567,9 +542,9 @@ impl PaperBsdf {
     }
 
     /// The mixture phase function (non-degenerate lobes) at cosine `cos`, as
-    /// `(numerator, denominator)` for callers that fold the division into their own: `w HG(cos; g) = k / (q sqrt(q))`,
-    /// `q = 1 + g^2 - 2 g cos`, both lobes over one denominator (an absent lobe
-    /// has `k = 0` and `q = 1`).
+    /// `(numerator, denominator)` for callers that fold the division into
+    /// their own: `w HG(cos; g) = k / (q sqrt(q))`, `q = 1 + g^2 - 2 g cos`,
+    /// both lobes over one denominator (an absent lobe has `k = 0`, `q = 1`).
     #[inline]
     fn phase_ratio(&self, cos: f64) -> (f64, f64) {
         let [(k0, a0, b0), (k1, a1, b1)] = self.lobe_hg;
@@ -783,15 +758,17 @@ impl PaperBsdf {
         let mut present = [false; 5];
         present[0] = !fx.is_index_matched();
         est[0] = fx.r_out_with_sqrt(mu, st);
-        // The tabulated channel means of the single and multiple lobes' albedos.
-        let tab = &self.lobe_tab[x];
-        let xs = st * (NS - 1) as f64;
-        let i = (xs as usize).min(NS - 2);
-        let f = xs - i as f64;
-        present[1..4].copy_from_slice(&self.lobe_present[x]);
-        for j in 0..3 {
-            est[1 + j] = att_o * (tab[i][j] * (1.0 - f) + tab[i + 1][j] * f);
-        }
+        let s = if self.opts.energy_bound {
+            lerp_tab_sqrt(&self.s_tab[x], st)
+        } else {
+            Rgb::ONE
+        };
+        present[1] = self.lobe_sum > 0.0 && self.albedo.max_channel() > 0.0;
+        est[1] = att_o * lerp_tab_sqrt(&self.ess_tab[x], st).mean();
+        present[2] = self.c_r[x].max_channel() > 0.0;
+        est[2] = att_o * (self.c_r[x] * s).mean() * PI * fx.abar;
+        present[3] = self.c_t[x].max_channel() > 0.0;
+        est[3] = att_o * (self.c_t[x] * s).mean() * PI * fo.abar;
         if self.opts.direct {
             let mu_in = fx.inside_cos(mu).max(1e-6);
             let tm = self.tau.mean();
