@@ -40,6 +40,7 @@ fn random_params(rng: &mut Pcg64) -> PaperParams {
         m_b: pick(rng, 0.0, 0.01, 1.5),
         dist_f: dist(rng),
         dist_b: dist(rng),
+        face_scattering: Default::default(),
     }
 }
 

@@ -55,6 +55,14 @@ pub const ETA_RANGE: (f64, f64) = (1.0, 5.0);
 /// Allowed range of `m` (DESIGN.md section 3).
 pub const M_RANGE: (f64, f64) = (0.0, std::f64::consts::FRAC_PI_2);
 
+/// Roughness below which an interface is smooth (the limit `m -> 0`). A
+/// microfacet lobe this narrow differs from the delta lobes only at order `m^2`
+/// (below 1e-8 in any albedo), while its `D ~ 1 / (pi m^2)` and the slopes of
+/// its visible normals lose precision and overflow for much smaller `m`
+/// (`m = 1e-9` gave inf/NaN). The parameter keeps its value; only the
+/// resolved [`Interface`] changes.
+pub const M_SMOOTH: f64 = 1e-4;
+
 impl RoughDielectric {
     /// A boundary with the given parameters; an error names any value outside
     /// DESIGN.md's ranges (`eta` in [1, 5], `m` in [0, pi/2]).
@@ -63,7 +71,7 @@ impl RoughDielectric {
         ParamError::check_range("m", m, M_RANGE.0, M_RANGE.1)?;
         let interface = if eta == 1.0 {
             Interface::IndexMatched
-        } else if m == 0.0 {
+        } else if m < M_SMOOTH {
             Interface::Smooth
         } else {
             Interface::Rough(Microfacet::new(dist, m))

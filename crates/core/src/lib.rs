@@ -23,11 +23,13 @@ pub mod params;
 pub mod phase;
 pub mod presets;
 pub mod quadrature;
+pub mod sheet;
 pub mod spectrum;
 
 pub use bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode};
 pub use dielectric::{RoughDielectric, RoughDielectricParams};
 pub use glam::DVec3;
 pub use microfacet::{Distribution, Microfacet};
-pub use params::{Colour, PaperParams, ParamError};
+pub use params::{Colour, FaceScattering, PaperParams, ParamError};
+pub use sheet::Sheet;
 pub use spectrum::Rgb;

@@ -57,6 +57,27 @@ impl ParamError {
         Ok(())
     }
 
+    /// The same error about the parameter `name + suffix` (`eta` of the
+    /// front face becomes `eta_f`).
+    pub fn with_suffix(self, suffix: &str) -> ParamError {
+        match self {
+            ParamError::OutOfRange { name, value, min, max } => ParamError::OutOfRange {
+                name: name + suffix,
+                value,
+                min,
+                max,
+            },
+            ParamError::NotFinite { name, value } => ParamError::NotFinite {
+                name: name + suffix,
+                value,
+            },
+            ParamError::Invalid { name, message } => ParamError::Invalid {
+                name: name + suffix,
+                message,
+            },
+        }
+    }
+
     /// The parameter this error is about.
     pub fn name(&self) -> &str {
         match self {
@@ -138,6 +159,46 @@ pub struct PaperParams {
     pub dist_f: Distribution,
     /// Microfacet distribution of the back face.
     pub dist_b: Distribution,
+    /// How the faces scatter among their microfacets: `multiple` (default,
+    /// energy-conserving faces) or `single` (Walter's faces, as in the paper).
+    #[serde(default)]
+    pub face_scattering: FaceScattering,
+}
+
+/// The faces' microfacet scattering (DESIGN.md 4.1, parameter `face_scattering`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FaceScattering {
+    /// Energy-conserving faces: every order of scattering among the microfacets
+    /// (Heitz et al. 2016 as ground truth; a reciprocal compensation in the model).
+    #[default]
+    Multiple,
+    /// Walter et al.'s single-scattering faces (the paper, Mitsuba's `roughdielectric`).
+    Single,
+}
+
+impl FaceScattering {
+    /// The name used in parameter files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            FaceScattering::Multiple => "multiple",
+            FaceScattering::Single => "single",
+        }
+    }
+}
+
+impl std::str::FromStr for FaceScattering {
+    type Err = ParamError;
+    fn from_str(s: &str) -> Result<Self, ParamError> {
+        match s.to_ascii_lowercase().as_str() {
+            "multiple" => Ok(FaceScattering::Multiple),
+            "single" => Ok(FaceScattering::Single),
+            _ => Err(ParamError::Invalid {
+                name: "face_scattering".into(),
+                message: format!("`{s}` is not one of `multiple`, `single`"),
+            }),
+        }
+    }
 }
 
 /// Smallest allowed thickness, mm (the `eps` of Table 2).

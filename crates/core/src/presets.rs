@@ -59,6 +59,7 @@ pub fn matte_office() -> PaperParams {
         m_b: 0.15,
         dist_f: Distribution::Ggx,
         dist_b: Distribution::Ggx,
+        face_scattering: Default::default(),
     }
 }
 
@@ -87,6 +88,7 @@ pub fn luster_photo() -> PaperParams {
         m_b: 0.3,
         dist_f: Distribution::Beckmann,
         dist_b: Distribution::Ggx,
+        face_scattering: Default::default(),
     }
 }
 
@@ -109,5 +111,6 @@ pub fn glossy_photo() -> PaperParams {
         m_b: 0.3,
         dist_f: Distribution::Beckmann,
         dist_b: Distribution::Ggx,
+        face_scattering: Default::default(),
     }
 }

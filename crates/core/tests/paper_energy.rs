@@ -64,6 +64,7 @@ fn random_params(rng: &mut Pcg64) -> PaperParams {
         m_b: pick(rng, 0.0, 0.01, std::f64::consts::FRAC_PI_2),
         dist_f: dist(rng),
         dist_b: dist(rng),
+        face_scattering: Default::default(),
     }
 }
 

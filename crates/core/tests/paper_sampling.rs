@@ -27,6 +27,7 @@ fn paper(d: f64, sa: Colour, ss: Colour, faces: Faces, phase: (f64, f64, f64)) -
         eta_b: faces[1].0,
         m_b: faces[1].1,
         dist_b: faces[1].2,
+        face_scattering: Default::default(),
     }
 }
 

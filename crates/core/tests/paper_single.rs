@@ -34,6 +34,7 @@ fn slab(d: f64, sa: f64, ss: f64, g_f: f64, g_b: f64, w_b: f64, eta_f: f64, eta_
         m_b: 0.0,
         dist_f: Distribution::Ggx,
         dist_b: Distribution::Ggx,
+        face_scattering: Default::default(),
     }
 }
 
@@ -166,6 +167,7 @@ fn rough_params() -> PaperParams {
         m_b: 0.6,
         dist_f: Distribution::Ggx,
         dist_b: Distribution::Beckmann,
+        face_scattering: Default::default(),
     }
 }
 

@@ -113,6 +113,7 @@ impl PaperFit {
             m_b: r[6],
             dist_f: self.dist_f,
             dist_b: self.dist_b,
+            face_scattering: Default::default(),
         }
     }
 }

@@ -595,6 +595,7 @@ fn paper_params_over(
             .dist_b
             .or(base.as_ref().map(|b| b.dist_b))
             .unwrap_or(Distribution::Ggx),
+        face_scattering: base.as_ref().map(|b| b.face_scattering).unwrap_or_default(),
     };
     p.validate().map_err(|e| err(file, entry, e.to_string()))?;
     Ok(p)

@@ -320,6 +320,7 @@ dist_b = "ggx""#;
         m_b: 0.3,
         dist_f: paperbsdf_core::Distribution::Ggx,
         dist_b: paperbsdf_core::Distribution::Ggx,
+        face_scattering: Default::default(),
     };
     let wo = paperbsdf_core::DVec3::new(0.6, 0.0, 0.8);
     let albedo = |p: &paperbsdf_core::PaperParams| {

@@ -40,6 +40,7 @@ fn paper(name: &str, d: f64, sigma_a: f64, sigma_s: f64, m_f: f64, m_b: f64, dis
         m_b,
         dist_f,
         dist_b: Distribution::Ggx,
+        face_scattering: Default::default(),
     }
 }
 

@@ -98,8 +98,8 @@ impl Slab {
     /// (the error names the parameter, its value and the allowed range).
     pub fn from_params(p: &PaperParams) -> Result<Slab, ParamError> {
         p.validate()?;
-        let front = RoughDielectric::new(p.dist_f, p.eta_f, p.m_f).map_err(|e| rename(e, "_f"))?;
-        let back = RoughDielectric::new(p.dist_b, p.eta_b, p.m_b).map_err(|e| rename(e, "_b"))?;
+        let front = RoughDielectric::new(p.dist_f, p.eta_f, p.m_f).map_err(|e| e.with_suffix("_f"))?;
+        let back = RoughDielectric::new(p.dist_b, p.eta_b, p.m_b).map_err(|e| e.with_suffix("_b"))?;
         Ok(Slab {
             d: p.d,
             front,
@@ -138,25 +138,5 @@ impl Slab {
     /// the first channel with the same medium (scalar parameters need one walk).
     pub fn distinct_channels(&self) -> [usize; 3] {
         std::array::from_fn(|c| (0..c).find(|&k| self.medium(k) == self.medium(c)).unwrap_or(c))
-    }
-}
-
-/// `eta`/`m` errors of a face renamed to the parameter-file names (`eta_f`, `m_b`, ...).
-fn rename(e: ParamError, suffix: &str) -> ParamError {
-    match e {
-        ParamError::OutOfRange { name, value, min, max } => ParamError::OutOfRange {
-            name: name + suffix,
-            value,
-            min,
-            max,
-        },
-        ParamError::NotFinite { name, value } => ParamError::NotFinite {
-            name: name + suffix,
-            value,
-        },
-        ParamError::Invalid { name, message } => ParamError::Invalid {
-            name: name + suffix,
-            message,
-        },
     }
 }

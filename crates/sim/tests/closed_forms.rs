@@ -33,6 +33,7 @@ fn params(a: f64, tau: f64, eta_f: f64, eta_b: f64) -> PaperParams {
         m_b: 0.0,
         dist_f: Distribution::Ggx,
         dist_b: Distribution::Ggx,
+        face_scattering: Default::default(),
     }
 }
 

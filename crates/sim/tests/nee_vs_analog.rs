@@ -90,6 +90,7 @@ fn paper(d: f64, sigma_s: f64, m_f: f64, m_b: f64, eta_f: f64, eta_b: f64) -> Pa
         m_b,
         dist_f: Distribution::Ggx,
         dist_b: Distribution::Beckmann,
+        face_scattering: Default::default(),
     }
 }
 

@@ -79,6 +79,7 @@ fn mixed_faces_and_back_lighting() {
         m_b: 0.3,
         dist_f: paperbsdf_core::Distribution::Ggx,
         dist_b: paperbsdf_core::Distribution::Beckmann,
+        face_scattering: Default::default(),
     };
     let slab = Slab::from_params(&p).unwrap();
     let (wi, wo) = in_plane_directions(50.0, 10.0, true);

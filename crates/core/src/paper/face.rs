@@ -91,22 +91,7 @@ fn lerp_sqrt(tab: &[f64; NA], st: f64) -> f64 {
 impl Face {
     /// The face `(dist, eta, m)`; errors name the parameters with `suffix` (`_f`, `_b`, or empty).
     pub fn new(dist: Distribution, eta: f64, m: f64, use_att: bool, suffix: &str) -> Result<Face, ParamError> {
-        let bd = RoughDielectric::new(dist, eta, m).map_err(|e| match e {
-            ParamError::OutOfRange { name, value, min, max } => ParamError::OutOfRange {
-                name: format!("{name}{suffix}"),
-                value,
-                min,
-                max,
-            },
-            ParamError::NotFinite { name, value } => ParamError::NotFinite {
-                name: format!("{name}{suffix}"),
-                value,
-            },
-            ParamError::Invalid { name, message } => ParamError::Invalid {
-                name: format!("{name}{suffix}"),
-                message,
-            },
-        })?;
+        let bd = RoughDielectric::new(dist, eta, m).map_err(|e| e.with_suffix(suffix))?;
         let si = surface_integrals(&bd);
         let mut f = Face {
             bd,

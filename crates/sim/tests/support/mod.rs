@@ -118,5 +118,6 @@ pub fn ad_params(albedo: f64, tau: f64, g: f64, n: f64) -> PaperParams {
         m_b: 0.0,
         dist_f: Distribution::Ggx,
         dist_b: Distribution::Ggx,
+        face_scattering: Default::default(),
     }
 }
