@@ -121,6 +121,11 @@ fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
     }
 }
 
+/// An (N, 3) array and an (N,) array returned to Python.
+type Arrays21<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
+/// Two (N, 3) arrays returned to Python.
+type Arrays22<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
+
 /// A model loaded by name from the registry of `paperbsdf-io` (`paper`,
 /// `reduced-multilayer`, `lambert-glass`, `rough-dielectric`).
 #[pyclass(module = "paperbsdf._native", frozen)]
@@ -232,7 +237,7 @@ impl Model {
         py: Python<'py>,
         wi: PyReadonlyArray2<'py, f64>,
         wo: PyReadonlyArray2<'py, f64>,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
+    ) -> PyResult<Arrays21<'py>> {
         let wi = directions("wi", &wi)?;
         let wo = directions("wo", &wo)?;
         same_len(("wi", wi.len()), ("wo", wo.len()))?;
@@ -308,7 +313,7 @@ impl Model {
         py: Python<'py>,
         theta_i_deg: PyReadonlyArray1<'py, f64>,
         side: &str,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+    ) -> PyResult<Arrays22<'py>> {
         let sign = match side {
             "front" => 1.0,
             "back" => -1.0,

@@ -229,3 +229,43 @@ def test_load_dict_errors():
     err({"preset": "matte", "params": "{}"}, r"either `params` or `preset`")
     err({}, r"give the property `params`")
     err({"model": "plastic", "params": json.dumps(p)}, r"unknown model `plastic`")
+
+
+def test_delta_lobes_are_delta_components():
+    """A smooth sheet (m = 0 on both faces): the plugin declares delta lobes,
+    sample returns DeltaReflection (the mirror direction) and DeltaTransmission
+    (straight through) with weight = the model's, and eval/pdf exclude them."""
+    mi = mitsuba("scalar_rgb")
+    p = dict(paperbsdf.preset("matte"), m_f=0.0, m_b=0.0, d=0.03, sigma_s=20.0)
+    plugin = mi.load_dict({"type": "paperbsdf", "params": json.dumps(p)})
+    F = mi.BSDFFlags
+    assert mi.has_flag(plugin.flags(), F.DeltaReflection) and mi.has_flag(plugin.flags(), F.DeltaTransmission)
+    ref = paperbsdf.PaperBsdf(p)
+    ctx = mi.BSDFContext()
+    viewer = [0.3, 0.1, float(np.sqrt(1 - 0.1))]
+    si = mi.SurfaceInteraction3f()
+    si.wi = mi.Vector3f(*viewer)
+    seen = set()
+    rng = np.random.default_rng(2)
+    for _ in range(300):
+        u = rng.random(3) * 0.999
+        bs, w = plugin.sample(ctx, si, float(u[0]), mi.Point2f(float(u[1]), float(u[2])))
+        t = mi.BSDFFlags(int(bs.sampled_type))
+        wo = np.array([bs.wo.x, bs.wo.y, bs.wo.z])
+        if mi.has_flag(t, F.DeltaReflection):
+            seen.add("R")
+            np.testing.assert_allclose(wo, [-0.3, -0.1, viewer[2]], atol=1e-6)
+        elif mi.has_flag(t, F.DeltaTransmission):
+            seen.add("T")
+            np.testing.assert_allclose(wo, [-0.3, -0.1, -viewer[2]], atol=1e-6)
+        else:
+            continue
+        _, _, pdf, _, weight = ref.sample_full(np.array([viewer]), u[None, :])
+        np.testing.assert_allclose(bs.pdf, pdf[0], rtol=1e-5)
+        np.testing.assert_allclose(np.array(w), weight[0], rtol=1e-5)
+        # eval and pdf see no delta lobe: at the delta direction they are the
+        # model's non-delta lobes only
+        f_ns = ref.eval(wo, np.array(viewer))[0] * abs(wo[2])
+        np.testing.assert_allclose(np.array(plugin.eval(ctx, si, bs.wo)), f_ns, rtol=1e-4)
+        np.testing.assert_allclose(plugin.pdf(ctx, si, bs.wo), ref.pdf(wo, np.array(viewer))[0], rtol=1e-4)
+    assert seen == {"R", "T"}

@@ -2,7 +2,7 @@
 `roughplastic`, on the comparison scene (scenes/compare.xml; for `roughplastic`
 its two paper sheets get a rough plastic of the same index and roughness),
 in samples per second (pixels x spp / wall-clock seconds of mi.render, after
-one warm-up render that compiles the JIT kernels).
+one warm-up render of the same size that compiles and caches the JIT kernels).
 
 Each measurement runs in its own Python process. In llvm_ad_rgb the plugin
 needs Dr.Jit's evaluated loops and calls; `roughplastic` is measured both
@@ -49,10 +49,13 @@ def measure(variant: str, bsdf: str, loops: str, spp: int) -> dict:
         dr.set_flag(dr.JitFlag.SymbolicConditionals, sym)
     scene = mi.load_string(scene_text(bsdf), spp=spp)
     w, h = scene.sensors()[0].film().size()
-    dr.eval(mi.render(scene, seed=99, spp=min(spp, 4)))  # warm-up (kernel compilation)
+    # Warm-up render of the same size (compiles and caches the JIT kernels).
+    dr.eval(mi.render(scene, seed=99, spp=spp))
+    dr.sync_thread()
     t0 = time.time()
     img = mi.render(scene, seed=1, spp=spp)
     dr.eval(img)
+    dr.sync_thread()  # LLVM kernels run asynchronously
     dt = time.time() - t0
     return {"variant": variant, "bsdf": bsdf, "loops": loops, "spp": spp, "seconds": dt,
             "samples_per_s": w * h * spp / dt}

@@ -216,6 +216,8 @@ def _make_class(mi, dr):
 
         # --- helpers -------------------------------------------------------
         def _eval_pdf_np(self, si, wo, active):
+            if jit:
+                dr.eval(si.wi, wo, active)  # one kernel launch for all the inputs
             n = _size(si.wi, wo, active)
             wi_v = _vec_np(si.wi, n)  # toward the viewer: paperbsdf's wo
             wo_l = _vec_np(wo, n)  # toward the light: paperbsdf's wi
@@ -240,6 +242,8 @@ def _make_class(mi, dr):
             return to_spec(value), to_float(pdf)
 
         def sample(self, ctx, si, sample1, sample2, active=True):
+            if jit:
+                dr.eval(si.wi, sample1, sample2, active)
             n = _size(si.wi, sample1, sample2.x, active)
             wi_v = _vec_np(si.wi, n)
             u = np.empty((n, 3))
