@@ -62,6 +62,9 @@ def write_images(mi, img, out_base: str, exposure: float = 1.0) -> tuple[str, st
             ldr = np.clip(arr * exposure, 0.0, 1.0)
             bmp = mi.Bitmap(ldr).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.UInt8, srgb_gamma=True)
             bmp.write(tmp)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600
         os.replace(tmp, out_base + ext)
         paths.append(out_base + ext)
     return paths[0], paths[1]
