@@ -71,14 +71,10 @@ def write_images(mi, img, out_base: str, exposure: float = 1.0) -> tuple[str, st
 
 
 def paperbsdf_cli() -> str:
-    """The `paperbsdf` command: $PAPERBSDF_CLI, else the workspace's release or
-    debug binary, else built with cargo (release)."""
+    """The `paperbsdf` command: $PAPERBSDF_CLI, else the workspace's release
+    build, brought up to date by cargo (a no-op when nothing changed)."""
     p = os.environ.get("PAPERBSDF_CLI")
     if p:
         return p
-    for prof in ("release", "debug"):
-        exe = os.path.join(REPO, "target", prof, "paperbsdf")
-        if os.path.exists(exe):
-            return exe
     subprocess.run(["cargo", "build", "--release", "-q", "-p", "paperbsdf-cli"], cwd=REPO, check=True)
     return os.path.join(REPO, "target", "release", "paperbsdf")

@@ -77,7 +77,8 @@ def compare(mi, spp: int = 16, passes: int = 8) -> dict:
     se = np.sqrt(s1**2 + s2**2)
     diff = np.abs(m1 - m2)
     tol = 3.0 * se + 0.01 * np.abs(m2)
-    z = (m1 - m2) / np.maximum(se, 1e-30)
+    # z where there is noise (blocks of pure background or black have se = 0)
+    z = np.where(se > 0, (m1 - m2) / np.where(se > 0, se, 1.0), 0.0)
     return {
         "ours": m1, "mitsuba": m2, "se": se, "z": z, "fail": diff > tol,
         "ratio": diff / tol, "seconds": (t_ours, t_mits),
