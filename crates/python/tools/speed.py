@@ -8,7 +8,7 @@ Each measurement runs in its own Python process. In llvm_ad_rgb the plugin
 needs Dr.Jit's evaluated loops and calls; `roughplastic` is measured both
 with Mitsuba's default (symbolic, one fused kernel) and evaluated loops.
 
-    python crates/python/tools/speed.py [--spp-scalar 4] [--spp-llvm 64]
+    python crates/python/tools/speed.py [--spp-scalar 8] [--spp-llvm 256]
 """
 
 from __future__ import annotations
@@ -63,8 +63,8 @@ def measure(variant: str, bsdf: str, loops: str, spp: int) -> dict:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--spp-scalar", type=int, default=4)
-    ap.add_argument("--spp-llvm", type=int, default=64)
+    ap.add_argument("--spp-scalar", type=int, default=8)
+    ap.add_argument("--spp-llvm", type=int, default=256)
     ap.add_argument("--one", nargs=4, metavar=("VARIANT", "BSDF", "LOOPS", "SPP"), help=argparse.SUPPRESS)
     a = ap.parse_args()
     if a.one:
