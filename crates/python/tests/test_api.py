@@ -165,6 +165,7 @@ def test_presets_and_load_params(repo):
     p = paperbsdf.load_params(os.path.join(repo, "params", "rough_glass.json"), model="rough-dielectric")
     assert "eta" in p
     assert paperbsdf.load_params(ps["glossy"]) == ps["glossy"]
+    assert paperbsdf.load_params("luster") == ps["luster"]
     # a preset by name and the same dict give the same model
     wi, wo = hard_pairs()
     np.testing.assert_array_equal(paperbsdf.PaperBsdf("luster").eval(wi, wo),
