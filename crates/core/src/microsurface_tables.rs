@@ -4,9 +4,9 @@
 //! microsurface (Heitz, Hanika, d'Eon, Dachsbacher 2016), for the model's
 //! compensation of energy-conserving faces (DESIGN.md 4.1).
 //!
-//! At every (distribution, eta, m) node of the grid of
-//! [`crate::boundary_tables`] ([`eta_node`], [`m_node`], 49 x 49 per
-//! distribution) the table holds four cosine-weighted hemispherical averages,
+//! At every other (distribution, eta, m) node of the grid of
+//! [`crate::boundary_tables`] ([`eta_node`], [`m_node`]: 25 x 25 per
+//! distribution, the same coordinates) the table holds four cosine-weighted hemispherical averages,
 //! each `2 int_0^1 X(mu) mu dmu`, flux fractions (no `eta^2`):
 //! `r_out2`, `t_out2` (light from outside reflected / transmitted by orders >= 2)
 //! and `r_in2`, `t_in2` (light from inside, the medium side, total internal
@@ -23,14 +23,22 @@
 //! nodes are the limit `eta -> 1+` of a rough face (an index-matched
 //! microsurface still masks, and its walk returns that light).
 
-use crate::boundary_tables::{eta_node, m_node, N_ETA, N_M};
+use crate::boundary_tables::{eta_node, m_node};
 use crate::microfacet::{Distribution, Microfacet};
 use crate::microsurface::Microsurface;
 use glam::DVec3;
 use std::sync::OnceLock;
 
 /// Walks per node and side of the committed table.
-pub const TABLE_WALKS: usize = 40_000;
+pub const TABLE_WALKS: usize = 24_000;
+/// Every `STRIDE`-th node of the boundary tables' grid in each of eta and m is
+/// a node here (the lost energy is smooth in (eta, m); the interpolation error
+/// of the coarser grid is measured in the tests).
+pub const STRIDE: usize = 2;
+/// Nodes in eta (`boundary_tables::eta_node(STRIDE * i)`).
+pub const N_ETA: usize = (crate::boundary_tables::N_ETA - 1) / STRIDE + 1;
+/// Nodes in m (`boundary_tables::m_node(STRIDE * j)`).
+pub const N_M: usize = (crate::boundary_tables::N_M - 1) / STRIDE + 1;
 /// f32 values per node: `r_out2, t_out2, r_in2, t_in2` and their standard errors.
 pub const NODE_LEN: usize = 8;
 /// Number of f32 values in the table file.
@@ -123,7 +131,8 @@ pub fn hemispherical_estimate(
                 for d in 0..4 {
                     q[d] = (shift[d] + (k as f64 + 1.0) * alpha[d]).fract();
                 }
-                let (mu, weight) = incidence(q[0], scale);
+                let mu_c = (sign < 0.0 && eta > 1.0).then(|| crate::boundary::critical_mu(eta));
+                let (mu, weight) = incidence(q[0], scale, mu_c);
                 let a = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, sign * mu);
                 let mut used = 0;
                 let mut next = || {
@@ -151,22 +160,44 @@ pub fn hemispherical_estimate(
 }
 
 /// The incident cosine for the uniform number `x`, and its weight: drawn from
-/// an equal mixture of the cosine-weighted density `2 mu` and a density
+/// an equal mixture of the cosine-weighted density `2 mu`, a density
 /// `1 / ((mu + w) ln(1 + 1/w))` uniform in `ln(mu + w)` (`w` = `scale`), which
-/// puts samples where a nearly smooth face loses energy (at grazing, `mu < m`,
-/// which cosine weighting reaches with probability `m^2`). The weight
-/// `2 mu / p(mu)` (at most 2) makes the average over `x` the cosine-weighted mean.
+/// puts samples where a nearly smooth face loses energy at grazing (`mu < m`,
+/// which cosine weighting reaches with probability `m^2`), and, from inside
+/// (`mu_c` = the critical cosine, `Some`), a density uniform in
+/// `ln(|mu - mu_c| + w')` on each side of the critical angle
+/// (`w' = scale sin theta_c`), where a nearly smooth face loses the light it
+/// refracts out at grazing. The weight `2 mu / p(mu)` makes the average over
+/// `x` the cosine-weighted mean.
 #[inline]
-fn incidence(x: f64, scale: f64) -> (f64, f64) {
+fn incidence(x: f64, scale: f64, mu_c: Option<f64>) -> (f64, f64) {
+    let k = if mu_c.is_some() { 3.0 } else { 2.0 };
     let l = (1.0 + 1.0 / scale).ln();
-    let mu = if x < 0.5 {
-        (2.0 * x).sqrt()
+    let crit = mu_c.map(|c| {
+        let w = (scale * (1.0 - c * c).sqrt()).max(1e-6);
+        (c, w, (1.0 + c / w).ln(), (1.0 + (1.0 - c) / w).ln())
+    });
+    let y = x * k;
+    let mu = if y < 1.0 {
+        y.sqrt()
+    } else if y < 2.0 {
+        scale * (((y - 1.0) * l).exp() - 1.0)
     } else {
-        scale * (((2.0 * x - 1.0) * l).exp() - 1.0)
+        let (c, w, l_lo, l_hi) = crit.expect("third component only with mu_c");
+        let z = 2.0 * (y - 2.0);
+        if z < 1.0 {
+            c - w * ((z * l_lo).exp() - 1.0)
+        } else {
+            c + w * (((z - 1.0) * l_hi).exp() - 1.0)
+        }
     }
     .clamp(1e-9, 1.0);
-    let p = mu + 0.5 / ((mu + scale) * l);
-    (mu, 2.0 * mu / p)
+    let mut p = 2.0 * mu + 1.0 / ((mu + scale) * l);
+    if let Some((c, w, l_lo, l_hi)) = crit {
+        let d = (mu - c).abs();
+        p += 0.5 / ((d + w) * if mu < c { l_lo } else { l_hi });
+    }
+    (mu, 2.0 * mu * k / p)
 }
 
 static TABLE_BYTES: &[u8] = include_bytes!("../data/microsurface_tables.bin");
@@ -228,8 +259,8 @@ pub fn lost_energy(dist: Distribution, eta: f64, m: f64) -> LostEnergy {
             continue;
         }
         let n = node(dist, ci, cj);
-        for k in 0..4 {
-            v[k] += w * n.value[k];
+        for (a, b) in v.iter_mut().zip(n.value) {
+            *a += w * b;
         }
     }
     LostEnergy {
@@ -240,7 +271,8 @@ pub fn lost_energy(dist: Distribution, eta: f64, m: f64) -> LostEnergy {
     }
 }
 
-/// `(eta, m)` of node (i, j) (those of [`crate::boundary_tables`]).
+/// `(eta, m)` of node (i, j): those of node `(STRIDE i, STRIDE j)` of
+/// [`crate::boundary_tables`].
 pub fn node_eta_m(i: usize, j: usize) -> (f64, f64) {
-    (eta_node(i), m_node(j))
+    (eta_node(STRIDE * i), m_node(STRIDE * j))
 }
