@@ -1,5 +1,5 @@
 //! Writes crates/core/data/microsurface_tables.bin (see `paperbsdf_core::microsurface_tables`):
-//! at every (distribution, eta, m) node of the boundary tables' grid, the
+//! at every other (distribution, eta, m) node of the boundary tables' grid, the
 //! cosine-weighted hemispherical fractions of the energy carried by orders >= 2
 //! of the multiple-scattering walk, for diffuse light from outside and from inside.
 //!
@@ -8,8 +8,9 @@
 //! `PAPERBSDF_MS_WALKS` sets the walks per node and side (default
 //! `microsurface_tables::TABLE_WALKS`); `PAPERBSDF_MS_TABLE_OUT` another output path.
 use indicatif::{ProgressBar, ProgressStyle};
-use paperbsdf_core::boundary_tables::{eta_node, m_node, N_ETA, N_M};
-use paperbsdf_core::microsurface_tables::{hemispherical_estimate, node_offset, NODE_LEN, TABLE_LEN, TABLE_WALKS};
+use paperbsdf_core::microsurface_tables::{
+    hemispherical_estimate, node_eta_m, node_offset, NODE_LEN, N_ETA, N_M, TABLE_LEN, TABLE_WALKS,
+};
 use paperbsdf_core::Distribution;
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
@@ -33,9 +34,10 @@ fn main() {
         .par_iter()
         .map(|&(d, i, j)| {
             let mut rng = rand_pcg::Pcg64::seed_from_u64(node_offset(d, i, j) as u64 + 0x5eed);
-            let e = hemispherical_estimate(d, eta_node(i), m_node(j), walks, &mut || rng.gen::<f64>());
+            let (eta, m) = node_eta_m(i, j);
+            let e = hemispherical_estimate(d, eta, m, walks, &mut || rng.gen::<f64>());
             bar.inc(1);
-            bar.set_message(format!("{:.2}", eta_node(i)));
+            bar.set_message(format!("{eta:.2}"));
             let mut v = [0f32; NODE_LEN];
             for k in 0..4 {
                 v[k] = e.value[k] as f32;

@@ -4,9 +4,9 @@
 //! microsurface (Heitz, Hanika, d'Eon, Dachsbacher 2016), for the model's
 //! compensation of energy-conserving faces (DESIGN.md 4.1).
 //!
-//! At every (distribution, eta, m) node of the grid of
-//! [`crate::boundary_tables`] ([`eta_node`], [`m_node`], 49 x 49 per
-//! distribution) the table holds four cosine-weighted hemispherical averages,
+//! At every other (distribution, eta, m) node of the grid of
+//! [`crate::boundary_tables`] ([`eta_node`], [`m_node`]: 25 x 25 per
+//! distribution, the same coordinates) the table holds four cosine-weighted hemispherical averages,
 //! each `2 int_0^1 X(mu) mu dmu`, flux fractions (no `eta^2`):
 //! `r_out2`, `t_out2` (light from outside reflected / transmitted by orders >= 2)
 //! and `r_in2`, `t_in2` (light from inside, the medium side, total internal
@@ -15,23 +15,30 @@
 //! `r_out2 + t_out2 = 1 - (R + T of Walter's face for diffuse light from outside)`
 //! (the same from inside); both are tested, not imposed.
 //!
-//! The values are Monte Carlo estimates ([`hemispherical_estimate`]:
-//! stratified cosine-weighted incidence, one walk per incident direction with
-//! the escapes replaced by their expected value), written as little-endian f32
+//! The values are randomised quasi-Monte Carlo estimates
+//! ([`hemispherical_estimate`]), written as little-endian f32
 //! in `data/microsurface_tables.bin` by
 //! `nice -n 10 cargo run --release -p paperbsdf-core --example gen_microsurface_tables`.
 //! The `m = 0` nodes are exactly 0 (a smooth face scatters once); the `eta = 1`
 //! nodes are the limit `eta -> 1+` of a rough face (an index-matched
 //! microsurface still masks, and its walk returns that light).
 
-use crate::boundary_tables::{eta_node, m_node, N_ETA, N_M};
+use crate::boundary_tables::{eta_node, m_node};
 use crate::microfacet::{Distribution, Microfacet};
 use crate::microsurface::Microsurface;
 use glam::DVec3;
 use std::sync::OnceLock;
 
 /// Walks per node and side of the committed table.
-pub const TABLE_WALKS: usize = 200_000;
+pub const TABLE_WALKS: usize = 24_000;
+/// Every `STRIDE`-th node of the boundary tables' grid in each of eta and m is
+/// a node here (the lost energy is smooth in (eta, m); the interpolation error
+/// of the coarser grid is measured in the tests).
+pub const STRIDE: usize = 2;
+/// Nodes in eta (`boundary_tables::eta_node(STRIDE * i)`).
+pub const N_ETA: usize = (crate::boundary_tables::N_ETA - 1) / STRIDE + 1;
+/// Nodes in m (`boundary_tables::m_node(STRIDE * j)`).
+pub const N_M: usize = (crate::boundary_tables::N_M - 1) / STRIDE + 1;
 /// f32 values per node: `r_out2, t_out2, r_in2, t_in2` and their standard errors.
 pub const NODE_LEN: usize = 8;
 /// Number of f32 values in the table file.
@@ -66,8 +73,7 @@ pub struct LostEnergy {
 pub struct HemisphericalEstimate {
     /// The estimates.
     pub value: [f64; 4],
-    /// Their standard errors (from the sample variance; the stratification of
-    /// the incident directions makes this an upper bound).
+    /// Their standard errors (from the spread of the randomised replicas).
     pub std_err: [f64; 4],
 }
 
@@ -83,11 +89,21 @@ impl HemisphericalEstimate {
     }
 }
 
+/// Independent randomised replicas of the quasi-Monte Carlo estimate in
+/// [`hemispherical_estimate`] (their spread gives the standard error).
+pub const REPLICAS: usize = 16;
+
 /// Estimates the four hemispherical values of the face (dist, eta, m) with
-/// `walks` walks per side (stratified cosine-weighted incidence `mu = sqrt(u)`,
-/// each walk's escapes replaced by their expected value), from the uniform
-/// numbers of `rnd`. `eta = 1` is the limit of a rough face as `eta -> 1+`;
-/// `m = 0` (smooth) gives exactly 0.
+/// `walks` walks per side, from the uniform numbers of `rnd`. The incident
+/// cosine and the three numbers of the first
+/// scattering event (the facet and the Fresnel choice, where most of the
+/// variance is) come from a 4-dimensional rank-1 lattice (the cosine drawn from
+/// a mixture that also covers grazing incidence, weighted) (Roberts' `R_4`
+/// sequence), randomly shifted in each of [`REPLICAS`] replicas (Cranley-Patterson
+/// rotation: unbiased, and the replicas' spread is an honest standard error);
+/// the rest of each walk is plain Monte Carlo with the escapes replaced by
+/// their expected value. `eta = 1` is the limit of a rough face as
+/// `eta -> 1+`; `m = 0` (smooth) gives exactly 0.
 pub fn hemispherical_estimate(
     dist: Distribution,
     eta: f64,
@@ -100,26 +116,88 @@ pub fn hemispherical_estimate(
         return out;
     }
     let s = Microsurface::new(Microfacet::new(dist, m), eta);
+    // R_4: alpha_k = phi^-k with phi the real root of x^5 = x + 1.
+    let phi = 1.167_303_978_261_418_7_f64;
+    let alpha = [1.0 / phi, phi.powi(-2), phi.powi(-3), phi.powi(-4)];
+    let per = walks.div_ceil(REPLICAS);
+    // The width of the grazing band where a nearly smooth face loses its energy.
+    let scale = (0.25 * m).max(1e-5);
     for (side, sign) in [(0usize, 1.0f64), (1, -1.0)] {
-        let (mut sum, mut sum2) = ([0.0f64; 2], [0.0f64; 2]);
-        for k in 0..walks {
-            let mu = ((k as f64 + rnd()) / walks as f64).sqrt().max(1e-9);
-            let a = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, sign * mu);
-            let (r, t) = s.higher_order_albedo_estimate(a, rnd);
-            for (q, x) in [r, t].into_iter().enumerate() {
-                sum[q] += x;
-                sum2[q] += x * x;
+        let mut reps = [[0.0f64; 2]; REPLICAS];
+        for rep in reps.iter_mut() {
+            let shift = [rnd(), rnd(), rnd(), rnd()];
+            for k in 0..per {
+                let mut q = [0.0; 4];
+                for d in 0..4 {
+                    q[d] = (shift[d] + (k as f64 + 1.0) * alpha[d]).fract();
+                }
+                let mu_c = (sign < 0.0 && eta > 1.0).then(|| crate::boundary::critical_mu(eta));
+                let (mu, weight) = incidence(q[0], scale, mu_c);
+                let a = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, sign * mu);
+                let mut used = 0;
+                let mut next = || {
+                    used += 1;
+                    if used < 4 {
+                        q[used]
+                    } else {
+                        rnd()
+                    }
+                };
+                let (r, t) = s.higher_order_albedo_estimate(a, &mut next);
+                rep[0] += weight * r / per as f64;
+                rep[1] += weight * t / per as f64;
             }
         }
-        let n = walks as f64;
         for q in 0..2 {
-            let mean = sum[q] / n;
-            let var = (sum2[q] / n - mean * mean).max(0.0);
+            let n = REPLICAS as f64;
+            let mean = reps.iter().map(|r| r[q]).sum::<f64>() / n;
+            let var = reps.iter().map(|r| (r[q] - mean) * (r[q] - mean)).sum::<f64>() / (n - 1.0);
             out.value[2 * side + q] = mean;
-            out.std_err[2 * side + q] = (var / (n - 1.0).max(1.0)).sqrt();
+            out.std_err[2 * side + q] = (var / n).sqrt();
         }
     }
     out
+}
+
+/// The incident cosine for the uniform number `x`, and its weight: drawn from
+/// an equal mixture of the cosine-weighted density `2 mu`, a density
+/// `1 / ((mu + w) ln(1 + 1/w))` uniform in `ln(mu + w)` (`w` = `scale`), which
+/// puts samples where a nearly smooth face loses energy at grazing (`mu < m`,
+/// which cosine weighting reaches with probability `m^2`), and, from inside
+/// (`mu_c` = the critical cosine, `Some`), a density uniform in
+/// `ln(|mu - mu_c| + w')` on each side of the critical angle
+/// (`w' = scale sin theta_c`), where a nearly smooth face loses the light it
+/// refracts out at grazing. The weight `2 mu / p(mu)` makes the average over
+/// `x` the cosine-weighted mean.
+#[inline]
+fn incidence(x: f64, scale: f64, mu_c: Option<f64>) -> (f64, f64) {
+    let k = if mu_c.is_some() { 3.0 } else { 2.0 };
+    let l = (1.0 + 1.0 / scale).ln();
+    let crit = mu_c.map(|c| {
+        let w = (scale * (1.0 - c * c).sqrt()).max(1e-6);
+        (c, w, (1.0 + c / w).ln(), (1.0 + (1.0 - c) / w).ln())
+    });
+    let y = x * k;
+    let mu = if y < 1.0 {
+        y.sqrt()
+    } else if y < 2.0 {
+        scale * (((y - 1.0) * l).exp() - 1.0)
+    } else {
+        let (c, w, l_lo, l_hi) = crit.expect("third component only with mu_c");
+        let z = 2.0 * (y - 2.0);
+        if z < 1.0 {
+            c - w * ((z * l_lo).exp() - 1.0)
+        } else {
+            c + w * (((z - 1.0) * l_hi).exp() - 1.0)
+        }
+    }
+    .clamp(1e-9, 1.0);
+    let mut p = 2.0 * mu + 1.0 / ((mu + scale) * l);
+    if let Some((c, w, l_lo, l_hi)) = crit {
+        let d = (mu - c).abs();
+        p += 0.5 / ((d + w) * if mu < c { l_lo } else { l_hi });
+    }
+    (mu, 2.0 * mu * k / p)
 }
 
 static TABLE_BYTES: &[u8] = include_bytes!("../data/microsurface_tables.bin");
@@ -181,8 +259,8 @@ pub fn lost_energy(dist: Distribution, eta: f64, m: f64) -> LostEnergy {
             continue;
         }
         let n = node(dist, ci, cj);
-        for k in 0..4 {
-            v[k] += w * n.value[k];
+        for (a, b) in v.iter_mut().zip(n.value) {
+            *a += w * b;
         }
     }
     LostEnergy {
@@ -193,7 +271,8 @@ pub fn lost_energy(dist: Distribution, eta: f64, m: f64) -> LostEnergy {
     }
 }
 
-/// `(eta, m)` of node (i, j) (those of [`crate::boundary_tables`]).
+/// `(eta, m)` of node (i, j): those of node `(STRIDE i, STRIDE j)` of
+/// [`crate::boundary_tables`].
 pub fn node_eta_m(i: usize, j: usize) -> (f64, f64) {
-    (eta_node(i), m_node(j))
+    (eta_node(STRIDE * i), m_node(STRIDE * j))
 }
