@@ -474,7 +474,7 @@ fn grey_image(
 
 /// Keys set in a material table that do not belong to its type.
 fn foreign_keys(m: &MaterialSpec, allowed: &[&str]) -> Vec<&'static str> {
-    let present: [(&'static str, bool); 20] = [
+    let present: [(&'static str, bool); 21] = [
         ("reflectance", m.reflectance.is_some()),
         ("params", m.params.is_some()),
         ("eta", m.eta.is_some()),
