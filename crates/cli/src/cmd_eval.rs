@@ -32,7 +32,10 @@ pub struct EvalArgs {
     pub out: Option<String>,
 }
 
-/// Arguments of `paperbsdf albedo`.
+/// Arguments of `paperbsdf albedo`: the fractions of the light arriving from
+/// polar angle `theta_i` (in the x-z plane) that the model reflects and
+/// transmits, i.e. `int f(wi, wo) |cos wo| dwo` over each hemisphere of
+/// outgoing directions, delta lobes included.
 #[derive(clap::Args, Debug)]
 pub struct AlbedoArgs {
     /// Model name (see `eval`).
