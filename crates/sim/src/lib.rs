@@ -20,6 +20,7 @@
 #![warn(missing_docs)]
 
 pub mod estimate;
+pub mod faces;
 pub mod slab;
 pub mod walk;
 
