@@ -118,7 +118,7 @@ impl FaceOptics {
         }
     }
 
-    /// A rough microfacet roughness of the face's top interface (0 for a delta face).
+    /// The face's air-side interface (the coating's top for a coated front).
     pub fn top(&self) -> &RoughDielectric {
         match self {
             FaceOptics::Walter(b) => b,
@@ -364,19 +364,21 @@ impl StochFace {
 /// The multiple-scattering microsurface walk (`paperbsdf_core::microsurface`).
 mod multiple {
     use super::*;
+    use paperbsdf_core::microsurface::{eval_multiple_estimate, sample_multiple};
 
     /// One draw of the walk: `(direction, weight)`.
+    #[inline]
     pub(super) fn sample(
         b: &RoughDielectric,
         w: DVec3,
         mode: TransportMode,
         rnd: &mut impl FnMut() -> f64,
     ) -> Option<(DVec3, f64)> {
-        let _ = (b, w, mode, rnd);
-        None
+        sample_multiple(b, w, mode, rnd).map(|s| (s.wi, s.weight))
     }
 
-    /// Unbiased estimate of the multiple-scattering BSDF value.
+    /// Unbiased estimate of the multiple-scattering BSDF value (no cosine).
+    #[inline]
     pub(super) fn eval(
         b: &RoughDielectric,
         wi: DVec3,
@@ -384,7 +386,6 @@ mod multiple {
         mode: TransportMode,
         rnd: &mut impl FnMut() -> f64,
     ) -> f64 {
-        let _ = (b, wi, wo, mode, rnd);
-        0.0
+        eval_multiple_estimate(b, wi, wo, mode, rnd)
     }
 }

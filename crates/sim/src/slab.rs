@@ -107,17 +107,6 @@ impl Slab {
         let fs = sheet.face_scattering;
         let front = FaceOptics::new(sheet.front, fs, sheet.coating);
         let back = FaceOptics::new(sheet.back, fs, None);
-        for (f, suffix) in [(&front, "_f"), (&back, "_b")] {
-            if matches!(f, FaceOptics::Stochastic(s) if s.multiple) {
-                return Err(ParamError::Invalid {
-                    name: "face_scattering".into(),
-                    message: format!(
-                        "`multiple` for the rough face m{suffix} = {} is not available in this build of the simulator (the microsurface walk is missing); use `single`",
-                        f.top().m
-                    ),
-                });
-            }
-        }
         Ok(Slab {
             front,
             back,

@@ -3,9 +3,11 @@
 //! # The walk (light tracing in depth only)
 //! Light arrives from direction `wi` (pointing toward the light) at the face
 //! it faces, carrying unit flux. Every event is sampled exactly from the
-//! physical system: surface events from the face's Walter BSDF in importance
-//! transport ([`RoughDielectric::sample_mode`], whose weight is the fraction of
-//! flux carried; smooth and index-matched faces are delta events), free paths
+//! physical system: surface events from the face's BSDF in importance
+//! transport ([`crate::faces`]: Walter's [`RoughDielectric::sample_mode`], the
+//! microsurface walk, or the sub-walk through a front coating, whose weight is
+//! the fraction of flux carried; smooth and index-matched faces and smooth
+//! coatings are delta events), free paths
 //! from `sigma_t` (Beer-Lambert), scattering directions from the phase
 //! function. Absorption is implicit (the weight is multiplied by the albedo at
 //! each collision) with Russian roulette below a weight of 0.01. Only depth
@@ -38,7 +40,15 @@
 //! (the camera-side strategy of a volumetric path tracer). Delta lobes are
 //! handled by their only strategy: a smooth or index-matched exit face by the
 //! refraction of `wo`, a smooth face vertex or a `|g| = 1` lobe by its
-//! expected value. Paths whose every event is a delta (the mirror reflection of
+//! expected value. A delta exit is reached directly or after any number of
+//! mirror reflections inside (at smooth faces, or at a coating's smooth
+//! boundary with the base): their geometric series is summed in closed form.
+//! Faces whose value is only estimated ([`crate::faces::FaceOptics::Stochastic`]:
+//! multiple scattering, coatings) have no density for MIS and use one strategy:
+//! exit sampling (the face sampled from `wo`, weight `f |cos| / pdf`) from every
+//! vertex with a known or estimated density, and the vertex's own sampled
+//! direction with an unbiased estimate of the exit face's value from delta
+//! vertices. Paths whose every event is a delta (the mirror reflection of
 //! a smooth face, unscattered light through two smooth faces) are Dirac deltas
 //! in `wo` and, as in `Bsdf::eval`, are not part of `f`; they are in the totals.
 //! Add to this the direct Walter reflection of the lit face when `wo` is on the
@@ -65,9 +75,11 @@
 //! With `f_imp(a, b) = eval_mode(a, b, Importance) = eval_mode(b, a, Radiance)`
 //! (the adjoint of Veach 1997, section 5.2), the light-tracing estimator here
 //! and a camera-side volumetric path tracer (Mitsuba's `volpath`) estimate the
-//! same integral. With `eta_f != eta_b` the slab is not a consistent physical
-//! medium and the transmission is not reciprocal; the simulator then computes
-//! exactly what Mitsuba computes for the same two interfaces.
+//! same integral. With `eta_f != eta_b` the sheet has a front coating
+//! (`paperbsdf_core::sheet`) and is reciprocal like any other; Mitsuba's
+//! references for such parameters (devB) put a medium of index `eta_f` behind
+//! the front and `eta_b` before the back instead (a prism-like slab), a
+//! different physical system.
 
 use crate::faces::{FaceOptics, StochFace};
 use crate::slab::{Face, Medium, Slab};

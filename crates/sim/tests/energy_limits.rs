@@ -116,6 +116,25 @@ fn white_furnace_with_lossless_faces_in_single_mode() {
 }
 
 #[test]
+fn white_furnace_with_multiple_scattering_faces() {
+    use Distribution::*;
+    let s = FaceScattering::Multiple;
+    let cases = [
+        // Thin, very rough back.
+        sheet(0.02, 200.0, (1.5, 0.5, Ggx), (1.5, 1.5, Beckmann), s),
+        // Thick, a rough coating of index 3 over a base of 1.3.
+        sheet(1.0, 10.0, (3.0, 0.3, Beckmann), (1.3, 0.8, Ggx), s),
+        // A very rough coating of lower index (1.2) over a base of 2.9 with a nearly smooth back.
+        sheet(0.1, 50.0, (1.2, 1.5, Ggx), (2.9, 0.05, Beckmann), s),
+        // No medium at all: the faces alone.
+        sheet(0.3, 0.0, (2.0, 1.0, Ggx), (2.0, 0.2, Ggx), s),
+        // Issue 14's unequal faces, without absorption.
+        sheet(0.08, 60.0, (1.6, 0.15, Beckmann), (1.3, 0.6, Ggx), s),
+    ];
+    furnace(&cases, 2048);
+}
+
+#[test]
 fn single_scattering_rough_faces_lose_energy_and_never_gain() {
     // Walter's faces drop the light that would meet the microsurface again: a
     // white sheet reflects and transmits less than it receives, coated or not.
@@ -139,7 +158,7 @@ fn limit_of_tiny_roughness_is_the_smooth_face() {
     // with 131072 walks (so 0.005 is 4.5 sigma of a difference), and m = 1e-9
     // reproduces m = 0 exactly (same seeds, same smooth face).
     use Distribution::*;
-    for fs in [FaceScattering::Single] {
+    for fs in [FaceScattering::Single, FaceScattering::Multiple] {
         let base = sheet(0.1, 40.0, (1.5, 0.0, Ggx), (1.5, 0.0, Beckmann), fs);
         let mut p0 = base.clone();
         p0.sigma_a = Colour::Scalar(1.0);

@@ -183,3 +183,17 @@ fn smooth_faces_and_coatings_chains_of_mirror_reflections() {
     let r = paper(0.02, 60.0, 0.25, 0.0, 1.3, 2.0);
     check_quad("low-index rough coating T 0", &r, 0.0, true, 30.0, (32, 2), 16_000);
 }
+
+#[test]
+fn multiple_scattering_faces() {
+    // The microsurface walk's faces: exit sampling by the walk, stochastic
+    // estimates of the faces' values at vertices, uncoated and coated fronts.
+    let mut p = paper(0.05, 120.0, 0.5, 0.9, 1.45, 1.45);
+    p.face_scattering = paperbsdf_core::FaceScattering::Multiple;
+    check("multiple R 60", &p, 60.0, false, 25.0, 8_000);
+    check("multiple T 0", &p, 0.0, true, 30.0, 8_000);
+    let mut q = paper(0.01, 50.0, 0.3, 0.5, 1.5, 1.3);
+    q.face_scattering = paperbsdf_core::FaceScattering::Multiple;
+    check("multiple coated thin T 0", &q, 0.0, true, 30.0, 16_000);
+    check("multiple coated thin R 30", &q, 30.0, false, 25.0, 8_000);
+}

@@ -160,3 +160,24 @@ fn smooth_coating_over_a_rough_back_is_reciprocal() {
     let (wi, wo) = in_plane_directions(35.0, 15.0, false);
     check("smooth coating R 35 15", &slab, wi, wo, 8192);
 }
+
+#[test]
+fn multiple_scattering_faces_are_reciprocal() {
+    // The default faces (the microsurface walk, sampled and estimated: one NEE
+    // strategy at a time) with issue 14's unequal faces and devA's grazing light.
+    let mut p = issue_sheet();
+    p.face_scattering = paperbsdf_core::FaceScattering::Multiple;
+    let slab = Slab::from_params(&p).unwrap();
+    let (wi, wo) = in_plane_directions(30.0, -60.0, true);
+    check("multiple: issue sheet T 30 -60", &slab, wi, wo, 8192);
+    let (wi, wo) = in_plane_directions(30.0, -60.0, false);
+    check("multiple: issue sheet R 30 -60", &slab, wi, wo, 8192);
+    let mut q = support::params("devA.json");
+    q.face_scattering = paperbsdf_core::FaceScattering::Multiple;
+    q.m_f = 0.8;
+    let slab = Slab::from_params(&q).unwrap();
+    let (wi, wo) = in_plane_directions(75.0, 0.0, false);
+    check("multiple: devA m_f 0.8 R 75 0", &slab, wi, wo, 8192);
+    let (wi, wo) = in_plane_directions(60.0, 20.0, true);
+    check("multiple: devA m_f 0.8 T 60 20", &slab, wi, wo, 8192);
+}
