@@ -1,4 +1,6 @@
 //! Time to a 1% standard error on one in-plane BSDF value (devA, theta_i = 30, R at theta_o = 0).
+//! `speed [devA|devB] [walks] [single|multiple] [adaptive]`: the faces of the parameter
+//! file (the default, `multiple`, when it does not say) unless `single` or `multiple` is given.
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_sim::*;
 /// CPU time (user + system) of this process in seconds, from /proc/self/stat.
@@ -16,7 +18,13 @@ fn main() {
     let name = args.get(1).map(String::as_str).unwrap_or("devA");
     let n: u64 = args.get(2).map(|s| s.parse().unwrap()).unwrap_or(32768);
     let text = std::fs::read_to_string(format!("../shared/reference/{name}.json")).unwrap();
-    let p: paperbsdf_core::PaperParams = serde_json::from_str(&text).unwrap();
+    let mut p: paperbsdf_core::PaperParams = serde_json::from_str(&text).unwrap();
+    for a in args.iter().skip(3) {
+        if let Ok(fs) = a.parse::<paperbsdf_core::FaceScattering>() {
+            p.face_scattering = fs;
+        }
+    }
+    println!("face_scattering = {}", p.face_scattering.name());
     let slab = Slab::from_params(&p).unwrap();
     let (wi, wo) = in_plane_directions(30.0, 0.0, false);
     let cfg = SimConfig {
@@ -37,7 +45,7 @@ fn main() {
         "collisions per walk: {:.1}",
         paperbsdf_sim::estimate::collisions_so_far() as f64 / r.samples as f64
     );
-    if std::env::args().nth(3).as_deref() != Some("adaptive") {
+    if !args.iter().skip(3).any(|a| a == "adaptive") {
         return;
     }
     let cfg = SimConfig {

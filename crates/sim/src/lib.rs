@@ -1,11 +1,17 @@
 //! # paperbsdf-sim: the ground truth
 //!
 //! A Monte Carlo simulation of the physical system the Paper BSDF approximates
-//! (DESIGN.md section 6): a laterally infinite slab of a homogeneous scattering
-//! medium (`sigma_a`, `sigma_s`, two-lobe Henyey-Greenstein phase function)
-//! between two Walter rough dielectric faces, with air on both sides. The walk
-//! is in depth only; every event is sampled exactly from the same building
-//! blocks as the model (`paperbsdf_core`'s `RoughDielectric` and phase
+//! (DESIGN.md section 6): the sheet of [`paperbsdf_core::sheet::Sheet`], the
+//! one description that model and simulator share: a laterally infinite slab of
+//! a homogeneous scattering medium (`sigma_a`, `sigma_s`, two-lobe
+//! Henyey-Greenstein phase function) of index `eta_b` between two rough
+//! dielectric faces, the front one over a thin coating of index `eta_f` when
+//! `eta_f != eta_b`, with air on both sides. The faces scatter once among their
+//! microfacets (Walter et al. 2007, `face_scattering = "single"`, as Mitsuba's
+//! `roughdielectric`) or any number of times (the microsurface walk of Heitz et
+//! al. 2016, `"multiple"`, the default), see [`faces`]. The walk is in depth
+//! only; every event is sampled exactly from the same building blocks as the
+//! model (`paperbsdf_core`'s `RoughDielectric`, microsurface walk and phase
 //! functions), so model and truth describe the same physical system.
 //!
 //! It estimates, with standard errors from independent batches:
@@ -20,6 +26,7 @@
 #![warn(missing_docs)]
 
 pub mod estimate;
+pub mod faces;
 pub mod slab;
 pub mod walk;
 

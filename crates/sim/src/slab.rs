@@ -1,16 +1,20 @@
-//! The physical system the simulator walks through: a laterally infinite slab
-//! of thickness `d` (front face `z = 0`, back face `z = -d`, DESIGN.md section 2)
-//! filled with a homogeneous medium (`sigma_a`, `sigma_s`, the two-lobe
-//! Henyey-Greenstein phase function of DESIGN.md 4.2) between two Walter rough
-//! dielectric faces (DESIGN.md 4.1), with air (index 1) outside both.
+//! The physical system the simulator walks through: the sheet of
+//! [`paperbsdf_core::sheet::Sheet`] (its module doc defines it; DESIGN.md
+//! sections 2, 4.1 and 6): a laterally infinite slab of thickness `d` (front
+//! face `z = 0`, back face `z = -d`) of a homogeneous medium of index `eta_b`
+//! (`sigma_a`, `sigma_s`, the two-lobe Henyey-Greenstein phase function of
+//! DESIGN.md 4.2) between two rough dielectric faces, the front one over a thin
+//! coating of index `eta_f` when `eta_f != eta_b`, with air (index 1) outside.
 //!
-//! Each face is a [`RoughDielectric`] in its own local frame, whose `+z` is the
+//! Each face is a [`FaceOptics`] in its own local frame, whose `+z` is the
 //! side of the air: for the front face that is the slab frame itself, for the
 //! back face the slab frame with `z` flipped ([`Face::local`]). The BSDFs are
 //! isotropic, so the mirror image is as good a frame as a rotation.
 
+use crate::faces::FaceOptics;
 use paperbsdf_core::phase::TwoLobeHg;
-use paperbsdf_core::{DVec3, PaperParams, ParamError, Rgb, RoughDielectric};
+use paperbsdf_core::sheet::Sheet;
+use paperbsdf_core::{DVec3, PaperParams, ParamError};
 
 /// One of the slab's two faces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -74,59 +78,62 @@ pub struct Medium {
     pub albedo: f64,
 }
 
-/// The physical paper slab of a [`PaperParams`]: the system the Paper BSDF approximates.
+/// The physical paper sheet of a [`PaperParams`] as the walk sees it: the
+/// system the Paper BSDF approximates, built from the one description of the
+/// sheet that model and simulator share ([`Sheet`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Slab {
-    /// Thickness, mm.
+    /// The physical sheet (thickness, medium, faces, coating, face scattering).
+    pub sheet: Sheet,
+    /// The front face (`z = 0`) as the walk treats it, in its local frame.
+    pub front: FaceOptics,
+    /// The back face (`z = -d`) as the walk treats it, in its local frame (slab `z` flipped).
+    pub back: FaceOptics,
+    /// Thickness, mm (`sheet.d`).
     pub d: f64,
-    /// The front face (`z = 0`) in its local frame.
-    pub front: RoughDielectric,
-    /// The back face (`z = -d`) in its local frame (slab `z` flipped).
-    pub back: RoughDielectric,
-    /// Phase function of the medium.
-    pub phase: TwoLobeHg,
-    /// Absorption coefficient per channel, 1/mm.
-    pub sigma_a: Rgb,
-    /// Scattering coefficient per channel, 1/mm.
-    pub sigma_s: Rgb,
     /// Whether the parameters were given in RGB (outputs then have three channels).
     pub rgb: bool,
 }
 
 impl Slab {
     /// The slab described by `p`, after checking every parameter's range
-    /// (the error names the parameter, its value and the allowed range).
+    /// (the error names the parameter as in parameter files, its value and the allowed range).
     pub fn from_params(p: &PaperParams) -> Result<Slab, ParamError> {
-        p.validate()?;
-        let front = RoughDielectric::new(p.dist_f, p.eta_f, p.m_f).map_err(|e| e.with_suffix("_f"))?;
-        let back = RoughDielectric::new(p.dist_b, p.eta_b, p.m_b).map_err(|e| e.with_suffix("_b"))?;
+        Slab::from_sheet(Sheet::from_params(p)?)
+    }
+
+    /// The slab of a sheet.
+    pub fn from_sheet(sheet: Sheet) -> Result<Slab, ParamError> {
+        let fs = sheet.face_scattering;
+        let front = FaceOptics::new(sheet.front, fs, sheet.coating);
+        let back = FaceOptics::new(sheet.back, fs, None);
         Ok(Slab {
-            d: p.d,
             front,
             back,
-            phase: TwoLobeHg {
-                g_f: p.g_f,
-                g_b: p.g_b,
-                w_b: p.w_b,
-            },
-            sigma_a: p.sigma_a.rgb(),
-            sigma_s: p.sigma_s.rgb(),
-            rgb: p.is_rgb(),
+            d: sheet.d,
+            rgb: sheet.rgb,
+            sheet,
         })
     }
 
-    /// The BSDF of a face.
+    /// How the walk treats a face.
     #[inline]
-    pub fn face(&self, f: Face) -> &RoughDielectric {
+    pub fn face(&self, f: Face) -> &FaceOptics {
         match f {
             Face::Front => &self.front,
             Face::Back => &self.back,
         }
     }
 
+    /// The phase function of the medium.
+    #[inline]
+    pub fn phase(&self) -> TwoLobeHg {
+        self.sheet.phase
+    }
+
     /// The medium of channel `c` (0, 1, 2).
     pub fn medium(&self, c: usize) -> Medium {
-        let (sa, ss) = (self.sigma_a.0[c], self.sigma_s.0[c]);
+        let (sa, ss) = (self.sheet.sigma_a.0[c], self.sheet.sigma_s.0[c]);
         let sigma_t = sa + ss;
         Medium {
             sigma_t,

@@ -3,9 +3,11 @@
 //! # The walk (light tracing in depth only)
 //! Light arrives from direction `wi` (pointing toward the light) at the face
 //! it faces, carrying unit flux. Every event is sampled exactly from the
-//! physical system: surface events from the face's Walter BSDF in importance
-//! transport ([`RoughDielectric::sample_mode`], whose weight is the fraction of
-//! flux carried; smooth and index-matched faces are delta events), free paths
+//! physical system: surface events from the face's BSDF in importance
+//! transport ([`crate::faces`]: Walter's [`RoughDielectric::sample_mode`], the
+//! microsurface walk, or the sub-walk through a front coating, whose weight is
+//! the fraction of flux carried; smooth and index-matched faces and smooth
+//! coatings are delta events), free paths
 //! from `sigma_t` (Beer-Lambert), scattering directions from the phase
 //! function. Absorption is implicit (the weight is multiplied by the albedo at
 //! each collision) with Russian roulette below a weight of 0.01. Only depth
@@ -38,7 +40,15 @@
 //! (the camera-side strategy of a volumetric path tracer). Delta lobes are
 //! handled by their only strategy: a smooth or index-matched exit face by the
 //! refraction of `wo`, a smooth face vertex or a `|g| = 1` lobe by its
-//! expected value. Paths whose every event is a delta (the mirror reflection of
+//! expected value. A delta exit is reached directly or after any number of
+//! mirror reflections inside (at smooth faces, or at a coating's smooth
+//! boundary with the base): their geometric series is summed in closed form.
+//! Faces whose value is only estimated ([`crate::faces::FaceOptics::Stochastic`]:
+//! multiple scattering, coatings) have no density for MIS and use one strategy:
+//! exit sampling (the face sampled from `wo`, weight `f |cos| / pdf`) from every
+//! vertex with a known or estimated density, and the vertex's own sampled
+//! direction with an unbiased estimate of the exit face's value from delta
+//! vertices. Paths whose every event is a delta (the mirror reflection of
 //! a smooth face, unscattered light through two smooth faces) are Dirac deltas
 //! in `wo` and, as in `Bsdf::eval`, are not part of `f`; they are in the totals.
 //! Add to this the direct Walter reflection of the lit face when `wo` is on the
@@ -65,10 +75,13 @@
 //! With `f_imp(a, b) = eval_mode(a, b, Importance) = eval_mode(b, a, Radiance)`
 //! (the adjoint of Veach 1997, section 5.2), the light-tracing estimator here
 //! and a camera-side volumetric path tracer (Mitsuba's `volpath`) estimate the
-//! same integral. With `eta_f != eta_b` the slab is not a consistent physical
-//! medium and the transmission is not reciprocal; the simulator then computes
-//! exactly what Mitsuba computes for the same two interfaces.
+//! same integral. With `eta_f != eta_b` the sheet has a front coating
+//! (`paperbsdf_core::sheet`) and is reciprocal like any other; Mitsuba's
+//! references for such parameters (devB) put a medium of index `eta_f` behind
+//! the front and `eta_b` before the back instead (a prism-like slab), a
+//! different physical system.
 
+use crate::faces::{FaceOptics, StochFace};
 use crate::slab::{Face, Medium, Slab};
 use paperbsdf_core::phase::{hg, sample_hg_cos};
 use paperbsdf_core::{DVec3, RoughDielectric, TransportMode};
@@ -90,11 +103,17 @@ const RR_SURVIVAL: f64 = 0.1;
 /// How light leaves the slab toward one requested viewing direction.
 #[derive(Clone, Copy, Debug)]
 enum Exit {
-    /// A rough exit face: both NEE strategies.
+    /// A rough single-scattering exit face: both NEE strategies.
     Rough(RoughDielectric),
-    /// A smooth or index-matched exit face: the only inside direction that
-    /// reaches `wo` is `-w_s` (propagation), with radiance factor `t_rad`.
-    Delta { w_s: DVec3, t_rad: f64 },
+    /// A face that is sampled exactly but only estimated (multiple scattering
+    /// or a coating): one NEE strategy at a time.
+    Stoch(StochFace),
+    /// A smooth or index-matched exit face (or film): the only inside direction
+    /// that reaches `wo` is `-w_s` (propagation), with radiance factor `t_rad`;
+    /// `r_x`, `r_y` are the delta reflectances inside the exit face and the
+    /// other face for light along that direction and its mirror image (chains
+    /// of internal mirror reflections before the exit).
+    Delta { w_s: DVec3, t_rad: f64, r_x: f64, r_y: f64 },
     /// No light reaches `wo` through this face (cannot happen from air).
     Blocked,
 }
@@ -241,14 +260,24 @@ impl<'a> Tracer<'a> {
             .map(|&wo| {
                 let face = Face::toward(wo);
                 let wo_l = face.local(wo);
-                let b = *slab.face(face);
-                let exit = match b.specular_lobes(wo_l, TransportMode::Radiance) {
-                    None => Exit::Rough(b),
-                    Some((_, t_rad, Some(dir_l))) if t_rad > 0.0 => Exit::Delta {
-                        w_s: face.local(dir_l),
-                        t_rad,
+                let exit = match *slab.face(face) {
+                    FaceOptics::Walter(b) => Exit::Rough(b),
+                    FaceOptics::Stochastic(s) => Exit::Stoch(s),
+                    FaceOptics::Delta(df) => match df.lobes(wo_l, TransportMode::Radiance) {
+                        (_, t_rad, Some(dir_l)) if t_rad > 0.0 => {
+                            let w_s = face.local(dir_l);
+                            let w = -w_s;
+                            let wm = DVec3::new(w.x, w.y, -w.z);
+                            let y = face.other();
+                            Exit::Delta {
+                                w_s,
+                                t_rad,
+                                r_x: slab.face(face).delta_reflectance_inside(face.local(-w)),
+                                r_y: slab.face(y).delta_reflectance_inside(y.local(-wm)),
+                            }
+                        }
+                        _ => Exit::Blocked,
                     },
-                    Some(_) => Exit::Blocked,
                 };
                 Target {
                     face,
@@ -260,7 +289,7 @@ impl<'a> Tracer<'a> {
                 }
             })
             .collect();
-        let p = slab.phase;
+        let p = slab.phase();
         let mut smooth_lobes = Vec::new();
         let mut delta_lobes = Vec::new();
         let mut lobes = Vec::new();
@@ -359,22 +388,33 @@ impl<'a> Tracer<'a> {
     }
 
     /// The vertex's flux density `q_v(w)` into propagation direction `w`
-    /// (non-delta part) and the density with which the walk draws `w`.
+    /// (non-delta part; an unbiased estimate at a stochastic face) and the
+    /// density with which the walk draws `w` (0 where it is not known: then
+    /// only the exit strategy is used).
     #[inline]
-    fn q_p(&self, v: Vertex, w: DVec3) -> (f64, f64) {
+    fn q_p<R: Rng>(&self, v: Vertex, w: DVec3, rng: &mut R) -> (f64, f64) {
         match v {
             Vertex::Volume { prev, .. } => {
                 let q = self.phase_smooth(prev.dot(w));
                 (q, q)
             }
             Vertex::Surface { face, w_from_l } => {
-                let b = self.slab.face(face);
                 let wl = face.local(w);
-                let q = b.eval_mode(wl, w_from_l, TransportMode::Importance) * w.z.abs();
-                if q == 0.0 {
-                    return (0.0, 0.0);
+                match self.slab.face(face) {
+                    FaceOptics::Walter(b) => {
+                        let q = b.eval_mode(wl, w_from_l, TransportMode::Importance) * w.z.abs();
+                        if q == 0.0 {
+                            return (0.0, 0.0);
+                        }
+                        (q, b.pdf_dir(wl, w_from_l))
+                    }
+                    FaceOptics::Stochastic(s) => {
+                        let mut rnd = || rng.gen::<f64>();
+                        let q = s.eval(wl, w_from_l, TransportMode::Importance, &mut rnd) * w.z.abs();
+                        (q, 0.0)
+                    }
+                    FaceOptics::Delta(_) => (0.0, 0.0),
                 }
-                (q, b.pdf_dir(wl, w_from_l))
             }
         }
     }
@@ -383,25 +423,21 @@ impl<'a> Tracer<'a> {
     /// strategy for a delta exit face), for every target reachable from `v`.
     fn nee_exit<R: Rng>(&self, v: Vertex, weight: f64, rng: &mut R, tally: &mut Tally) {
         let z = self.depth(v);
-        let skip = match v {
+        let d = self.slab.d;
+        let at_face = match v {
             Vertex::Surface { face, .. } => Some(face),
             Vertex::Volume { .. } => None,
         };
         for (j, t) in self.targets.iter().enumerate() {
-            if Some(t.face) == skip {
+            let own_face = at_face == Some(t.face);
+            if own_face && !matches!(t.exit, Exit::Delta { r_y, .. } if r_y > 0.0) {
                 continue;
             }
-            let dz = (z - t.face.z(self.slab.d)).abs();
+            let dz = (z - t.face.z(d)).abs();
             match t.exit {
-                Exit::Rough(_) => {
+                Exit::Rough(_) | Exit::Stoch(_) => {
                     let e = if t.pool.is_empty() {
-                        let mut one = [ExitDraw {
-                            w: DVec3::ZERO,
-                            f: 0.0,
-                            p2: 0.0,
-                        }];
-                        one[0] = draw_exit(t, rng.gen(), [rng.gen(), rng.gen()]);
-                        one[0]
+                        draw_exit(t, rng)
                     } else {
                         t.pool[rng.gen_range(0..t.pool.len())]
                     };
@@ -413,26 +449,52 @@ impl<'a> Tracer<'a> {
                     let Some(rr) = nee_roulette(weight * tr * e.f, rng) else {
                         continue;
                     };
-                    let (q, p1) = self.q_p(v, e.w);
+                    let (q, p1) = self.q_p(v, e.w, rng);
                     if q <= 0.0 {
                         continue;
                     }
-                    // (f / p2) * p2 / (p1 + p2) with MIS, f / p2 without.
-                    let p1 = if t.mis_volume || matches!(v, Vertex::Surface { .. }) {
-                        p1
-                    } else {
-                        0.0
-                    };
+                    // (f / p2) * p2 / (p1 + p2) with MIS, f / p2 without (a
+                    // stochastic exit stores f / p2 as `f` with `p2 = 1`).
+                    let p1 =
+                        if matches!(t.exit, Exit::Rough(_)) && (t.mis_volume || matches!(v, Vertex::Surface { .. })) {
+                            p1
+                        } else {
+                            0.0
+                        };
                     let c = rr * weight * q * tr * e.f / (p1 + e.p2);
                     if c.is_finite() {
                         tally.add_f(j, c);
                     }
                 }
-                Exit::Delta { w_s, t_rad } => {
+                Exit::Delta { w_s, t_rad, r_x, r_y } => {
                     let w = -w_s;
-                    let (q, _) = self.q_p(v, w);
-                    if q > 0.0 {
-                        tally.add_f(j, weight * q * self.transmittance(dz, w) * t_rad / w.z.abs());
+                    let a = w.z.abs();
+                    // Light along w reaches the exit directly (n = 0) or after n
+                    // round trips of mirror reflections inside (factor r_x r_y
+                    // and 2 d of depth each); light along the mirror image first
+                    // meets the other face (factor r_y, depth |z - z_y| + d).
+                    let round = r_x * r_y;
+                    let series = if round > 0.0 {
+                        1.0 / (1.0 - round * self.transmittance(2.0 * d, w))
+                    } else {
+                        1.0
+                    };
+                    if !own_face {
+                        let (q, _) = self.q_p(v, w, rng);
+                        if q > 0.0 {
+                            let c = weight * q * self.transmittance(dz, w) * t_rad / a;
+                            tally.add_f(j, c * series);
+                        }
+                    }
+                    let from_other_face = at_face == Some(t.face.other());
+                    if r_y > 0.0 && !from_other_face {
+                        let wm = DVec3::new(w.x, w.y, -w.z);
+                        let (q, _) = self.q_p(v, wm, rng);
+                        if q > 0.0 {
+                            let dy = (z - t.face.other().z(d)).abs() + d;
+                            let c = weight * q * r_y * self.transmittance(dy, w) * t_rad / a;
+                            tally.add_f(j, c * series);
+                        }
                     }
                 }
                 Exit::Blocked => {}
@@ -454,7 +516,13 @@ impl<'a> Tracer<'a> {
             if t.face != x {
                 continue;
             }
-            let Exit::Rough(b) = t.exit else { continue };
+            let stoch = match t.exit {
+                Exit::Rough(_) => None,
+                // A stochastic exit has no density for MIS: exit sampling covers
+                // it at every vertex that has a density, this strategy at delta ones.
+                Exit::Stoch(s) if p1.is_none() => Some(s),
+                _ => continue,
+            };
             if p1.is_some() && !t.mis_volume && matches!(v, Vertex::Volume { .. }) {
                 continue; // exit sampling alone covers this target at volume vertices
             }
@@ -465,13 +533,20 @@ impl<'a> Tracer<'a> {
                 continue;
             };
             let ws_l = x.local(-w);
-            let f = b.eval_mode(ws_l, t.wo_l, TransportMode::Radiance);
+            let f = match (stoch, t.exit) {
+                (Some(s), _) => {
+                    let mut rnd = || rng.gen::<f64>();
+                    s.eval(ws_l, t.wo_l, TransportMode::Radiance, &mut rnd)
+                }
+                (None, Exit::Rough(b)) => b.eval_mode(ws_l, t.wo_l, TransportMode::Radiance),
+                _ => 0.0,
+            };
             if f == 0.0 {
                 continue;
             }
-            let mis = match p1 {
-                None => 1.0,
-                Some(p1) => p1 / (p1 + b.pdf_dir(ws_l, t.wo_l)),
+            let mis = match (p1, t.exit) {
+                (Some(p1), Exit::Rough(b)) => p1 / (p1 + b.pdf_dir(ws_l, t.wo_l)),
+                _ => 1.0,
             };
             let c = rr * weight * tr * f * mis;
             if c.is_finite() {
@@ -495,7 +570,6 @@ impl<'a> Tracer<'a> {
         tally: &mut Tally,
         on_exit: &mut E,
     ) -> Option<(DVec3, f64)> {
-        let b = self.slab.face(face);
         let v = Vertex::Surface { face, w_from_l };
         let from_outside = w_from_l.z > 0.0;
         let mut exit = |tally: &mut Tally, w: f64, dir_l: DVec3| {
@@ -506,8 +580,8 @@ impl<'a> Tracer<'a> {
             }
             on_exit(face.local(dir_l), w);
         };
-        match b.specular_lobes(w_from_l, TransportMode::Importance) {
-            None => {
+        match self.slab.face(face) {
+            FaceOptics::Walter(b) => {
                 self.nee_exit(v, weight, rng, tally);
                 let (uc, u0, u1) = (rng.gen::<f64>(), rng.gen::<f64>(), rng.gen::<f64>());
                 let s = b.sample_mode(w_from_l, uc, [u0, u1], TransportMode::Importance)?;
@@ -524,7 +598,29 @@ impl<'a> Tracer<'a> {
                 self.nee_dir(v, nw, w, Some(s.pdf), rng, tally);
                 Some((w, nw))
             }
-            Some((r, t, t_dir)) => {
+            FaceOptics::Stochastic(sf) => {
+                // Exit sampling covers the non-delta part of this face at every
+                // target; its delta part (a coating's mirror reflection) is
+                // covered along the sampled direction.
+                self.nee_exit(v, weight, rng, tally);
+                let mut rnd = || rng.gen::<f64>();
+                let s = sf.sample(w_from_l, TransportMode::Importance, &mut rnd)?;
+                if !(s.weight.is_finite() && s.weight > 0.0) {
+                    return None;
+                }
+                let nw = weight * s.weight;
+                if s.dir.z > 0.0 {
+                    exit(tally, nw, s.dir);
+                    return None;
+                }
+                let w = face.local(s.dir);
+                if s.delta {
+                    self.nee_dir(v, nw, w, None, rng, tally);
+                }
+                Some((w, nw))
+            }
+            FaceOptics::Delta(df) => {
+                let (r, t, t_dir) = df.lobes(w_from_l, TransportMode::Importance);
                 // Delta interface: the lobe into the slab and the lobe out of it.
                 let mirror = DVec3::new(-w_from_l.x, -w_from_l.y, w_from_l.z);
                 let (into, out) = if from_outside {
@@ -571,10 +667,17 @@ impl<'a> Tracer<'a> {
         let lit = Face::lit_by(wi);
         let wi_l = lit.local(wi);
         // The lit face's own reflection toward viewers on its side.
-        let b = self.slab.face(lit);
         for (j, t) in self.targets.iter().enumerate() {
             if t.face == lit {
-                tally.add_f(j, b.eval_mode(wi_l, t.wo_l, TransportMode::Radiance));
+                let f = match self.slab.face(lit) {
+                    FaceOptics::Walter(b) => b.eval_mode(wi_l, t.wo_l, TransportMode::Radiance),
+                    FaceOptics::Stochastic(s) => {
+                        let mut rnd = || rng.gen::<f64>();
+                        s.eval(wi_l, t.wo_l, TransportMode::Radiance, &mut rnd)
+                    }
+                    FaceOptics::Delta(_) => 0.0,
+                };
+                tally.add_f(j, f);
             }
         }
         let Some((mut dir, mut weight)) = self.surface_vertex(lit, wi_l, 1.0, lit, rng, tally, on_exit) else {
@@ -666,32 +769,48 @@ fn nee_roulette<R: Rng>(bound: f64, rng: &mut R) -> Option<f64> {
     }
 }
 
-/// One draw of a rough exit face sampled from the target's `wo`.
-fn draw_exit(t: &Target, uc: f64, u: [f64; 2]) -> ExitDraw {
+/// One draw of a rough exit face sampled from the target's `wo`. For a
+/// stochastic face (no density known) the draw stores `f / p2 = weight / |cos|`
+/// as `f` with `p2 = 1`.
+fn draw_exit<R: Rng>(t: &Target, rng: &mut R) -> ExitDraw {
     let none = ExitDraw {
         w: DVec3::ZERO,
         f: 0.0,
         p2: 0.0,
     };
-    let Exit::Rough(b) = t.exit else { return none };
-    match b.sample_mode(t.wo_l, uc, u, TransportMode::Radiance) {
-        Some(s) if s.wi.z < 0.0 && s.pdf > 0.0 && s.f.0[0] > 0.0 && s.f.0[0].is_finite() => ExitDraw {
-            w: -t.face.local(s.wi),
-            f: s.f.0[0],
-            p2: s.pdf,
-        },
+    match t.exit {
+        Exit::Rough(b) => {
+            let (uc, u0, u1) = (rng.gen(), rng.gen(), rng.gen());
+            match b.sample_mode(t.wo_l, uc, [u0, u1], TransportMode::Radiance) {
+                Some(s) if s.wi.z < 0.0 && s.pdf > 0.0 && s.f.0[0] > 0.0 && s.f.0[0].is_finite() => ExitDraw {
+                    w: -t.face.local(s.wi),
+                    f: s.f.0[0],
+                    p2: s.pdf,
+                },
+                _ => none,
+            }
+        }
+        Exit::Stoch(sf) => {
+            let mut rnd = || rng.gen::<f64>();
+            match sf.sample(t.wo_l, TransportMode::Radiance, &mut rnd) {
+                Some(s) if s.dir.z < 0.0 && s.weight > 0.0 && s.weight.is_finite() => ExitDraw {
+                    w: -t.face.local(s.dir),
+                    f: s.weight / s.dir.z.abs(),
+                    p2: 1.0,
+                },
+                _ => none,
+            }
+        }
         _ => none,
     }
 }
 
 /// `n` independent draws of a target's exit face (empty for a delta exit).
 fn draw_exits<R: Rng>(t: &Target, n: usize, rng: &mut R) -> Vec<ExitDraw> {
-    if !matches!(t.exit, Exit::Rough(_)) {
+    if !matches!(t.exit, Exit::Rough(_) | Exit::Stoch(_)) {
         return Vec::new();
     }
-    (0..n)
-        .map(|_| draw_exit(t, rng.gen(), [rng.gen(), rng.gen()]))
-        .collect()
+    (0..n).map(|_| draw_exit(t, rng)).collect()
 }
 
 /// Mean BSDF value of the transmitted draws (0 when there are none).

@@ -2,12 +2,18 @@
 //!
 //! Single scattering (Hanrahan & Krueger 1993): with a tiny albedo `a`, higher
 //! orders are `O(a)` relative, so `f / a` is the single-scattering kernel to
-//! within `a`. With a smooth front of index `eta` and an index-matched back,
-//! the only single-scattering reflection path is in, scatter, out through the
-//! front, so exactly
-//! `f_r = (1 - F(mu_i)) (1 - F(mu_o)) a p(cos_s) (1 - exp(-tau (1/mu_i' + 1/mu_o'))) / (eta^2 (mu_i' + mu_o'))`
-//! with `mu'` the refracted cosines (DESIGN.md 4.4); with both faces
-//! index-matched, `f_t = a p (exp(-tau/mu_o) - exp(-tau/mu_i)) / (mu_o - mu_i)`.
+//! within `a`. A sheet with `eta_b = 1` and a smooth front of `eta_f = eta` is a
+//! medium of index 1 under a smooth film of index `eta` (the coating of
+//! `paperbsdf_core::sheet`), with an index-matched back; the only
+//! single-scattering reflection path is in through the film, scatter, out
+//! through the film, and directions inside are those outside, so exactly
+//! `f_r = Tf(mu_i) Tf(mu_o) a p(cos_s) (1 - exp(-tau (1/mu_i + 1/mu_o))) / (mu_i + mu_o)`
+//! with the film's transmittance `Tf = (1 - F)^2 / (1 - F^2) = (1 - F) / (1 + F)`
+//! (incoherent multiple reflections between two interfaces of the same Fresnel
+//! reflectance `F(mu)`, Born & Wolf 1.6), DESIGN.md 4.4 with `eta = 1` inside.
+//! This checks the coating's two interfaces, their bounces and the radiance
+//! factors of its refractions. With both faces index-matched,
+//! `f_t = a p (exp(-tau/mu_o) - exp(-tau/mu_i)) / (mu_o - mu_i)`.
 //! Tolerance: 4 standard errors plus `2 a` relative for the multiple scattering.
 
 mod support;
@@ -33,12 +39,18 @@ fn params(a: f64, tau: f64, eta_f: f64, eta_b: f64) -> PaperParams {
         m_b: 0.0,
         dist_f: Distribution::Ggx,
         dist_b: Distribution::Ggx,
-        face_scattering: Default::default(),
+        face_scattering: paperbsdf_core::FaceScattering::Single,
     }
 }
 
+/// Transmittance of a smooth film of index `eta` in air (module doc).
+fn film(mu: f64, eta: f64) -> f64 {
+    let f = fresnel_dielectric(mu, eta);
+    (1.0 - f) / (1.0 + f)
+}
+
 #[test]
-fn single_scattering_reflection_through_a_smooth_face() {
+fn single_scattering_reflection_through_a_smooth_coating() {
     let (a, tau, eta) = (1e-3, 0.8, 1.5);
     let slab = Slab::from_params(&params(a, tau, eta, 1.0)).unwrap();
     let phase = TwoLobeHg {
@@ -58,19 +70,11 @@ fn single_scattering_reflection_through_a_smooth_face() {
     };
     let run = simulate_bsdf(&slab, wi, &wos, &cfg).unwrap();
     for (k, &wo) in wos.iter().enumerate() {
-        let refr = |w: paperbsdf_core::DVec3| {
-            paperbsdf_core::geometry::refract(w, paperbsdf_core::DVec3::Z, 1.0 / eta).unwrap()
-        };
-        let (ii, oo) = (refr(wi), refr(wo)); // inside, pointing down
-        let (mi, mo) = (-ii.z, -oo.z);
-        // Propagation: -ii goes in... light propagates along ii (down), leaves along -oo (up).
-        let cos_s = ii.dot(-oo);
-        let want = (1.0 - fresnel_dielectric(wi.z, eta))
-            * (1.0 - fresnel_dielectric(wo.z, eta))
-            * a
-            * phase.eval(cos_s)
-            * (1.0 - (-tau * (1.0 / mi + 1.0 / mo)).exp())
-            / (eta * eta * (mi + mo));
+        // Inside (index 1) the light propagates along -wi and leaves along wo.
+        let (mi, mo) = (wi.z, wo.z);
+        let cos_s = (-wi).dot(wo);
+        let want = film(mi, eta) * film(mo, eta) * a * phase.eval(cos_s) * (1.0 - (-tau * (1.0 / mi + 1.0 / mo)).exp())
+            / (mi + mo);
         let (m, se) = (run.f[k].mean.0[0], run.f[k].stderr.0[0]);
         eprintln!("R theta_o {}: sim {m:.6e} +- {se:.2e}, closed form {want:.6e}", tos[k]);
         assert!(
@@ -202,7 +206,7 @@ fn rgb_channels_are_independent_walks() {
 
 #[test]
 fn scattering_orders_sum_to_f_and_order_one_is_single_scattering() {
-    // Same geometry as the single-scattering test but a white medium (albedo 0.9):
+    // Same sheet as the single-scattering test but a white medium (albedo 0.9):
     // the order-1 part must still be the closed form exactly, and the orders sum to f.
     let (a, tau, eta) = (0.9, 0.8, 1.5);
     let slab = Slab::from_params(&params(a, tau, eta, 1.0)).unwrap();
@@ -231,16 +235,10 @@ fn scattering_orders_sum_to_f_and_order_one_is_single_scattering() {
         o[0].mean.0[0], 0.0,
         "a smooth face reflects only in the mirror direction"
     );
-    let refr =
-        |w: paperbsdf_core::DVec3| paperbsdf_core::geometry::refract(w, paperbsdf_core::DVec3::Z, 1.0 / eta).unwrap();
-    let (ii, oo) = (refr(wi), refr(wo));
-    let (mi, mo) = (-ii.z, -oo.z);
-    let want = (1.0 - fresnel_dielectric(wi.z, eta))
-        * (1.0 - fresnel_dielectric(wo.z, eta))
-        * a
-        * phase.eval(ii.dot(-oo))
-        * (1.0 - (-tau * (1.0 / mi + 1.0 / mo)).exp())
-        / (eta * eta * (mi + mo));
+    let (mi, mo) = (wi.z, wo.z);
+    let want =
+        film(mi, eta) * film(mo, eta) * a * phase.eval((-wi).dot(wo)) * (1.0 - (-tau * (1.0 / mi + 1.0 / mo)).exp())
+            / (mi + mo);
     let (m, se) = (o[1].mean.0[0], o[1].stderr.0[0]);
     eprintln!(
         "order 1: {m:.5} +- {se:.5}, closed form {want:.5}; order 2+: {:.5}",

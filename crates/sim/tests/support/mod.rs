@@ -2,8 +2,14 @@
 //! `../shared/reference` beside the repository (as in CI; `$PAPERBSDF_SHARED/reference`
 //! overrides), produced by Mitsuba 3 and iadpython.
 //!
-//! Known defect of that data: devA's `R` rows at `theta_i = 75` are not reciprocal (see
-//! `../mitsuba_slab.rs` and `../../tools/mitsuba_reciprocity.py`); the tests do not count them.
+//! Known defect of that data: the `theta_i = 75` rows of devA.csv and devB.csv are not
+//! reciprocal (Mitsuba's directional light at grazing incidence on a rough face; see
+//! `../mitsuba_slab.rs` and `../../tools/mitsuba_reciprocity.py`). [`read_inplane_fixed`]
+//! replaces them by the reciprocal remeasurement in `devA_grazing.csv`, `devB_grazing.csv`.
+//!
+//! The references were made with Walter's single-scattering faces (Mitsuba's
+//! `roughdielectric`) or smooth faces, so the parameters read here have
+//! `face_scattering = "single"` whatever the file says.
 
 #![allow(dead_code)]
 
@@ -19,10 +25,13 @@ pub fn data(name: &str) -> PathBuf {
         .join(name)
 }
 
-/// Parameters from a JSON file of the reference data.
+/// Parameters from a JSON file of the reference data, with Walter's single-scattering
+/// faces (`face_scattering = "single"`, as the references were made).
 pub fn params(name: &str) -> PaperParams {
     let text = std::fs::read_to_string(data(name)).unwrap();
-    serde_json::from_str(&text).unwrap()
+    let mut p: PaperParams = serde_json::from_str(&text).unwrap();
+    p.face_scattering = paperbsdf_core::FaceScattering::Single;
+    p
 }
 
 /// A row of a Mitsuba in-plane reference (devA.csv, devB.csv).
@@ -56,6 +65,28 @@ pub fn read_inplane(name: &str) -> Vec<RefRow> {
             }
         })
         .collect()
+}
+
+/// The rows of `{name}.csv` with its `theta_i = 75` rows replaced by those of
+/// `{name}_grazing.csv` (the reciprocal remeasurement). Returns the rows and,
+/// for each, whether it comes from the grazing file with `theta_o = +-80`, where
+/// the light of the remeasurement is itself grazing and the value remains doubtful.
+pub fn read_inplane_fixed(name: &str) -> Vec<(RefRow, bool)> {
+    let mut rows: Vec<(RefRow, bool)> = read_inplane(&format!("{name}.csv"))
+        .into_iter()
+        .filter(|r| r.theta_i != 75.0)
+        .map(|r| (r, false))
+        .collect();
+    let grazing = read_inplane(&format!("{name}_grazing.csv"));
+    assert!(
+        grazing.len() == 18 && grazing.iter().all(|r| r.theta_i == 75.0),
+        "{name}_grazing.csv: expected the 18 rows at theta_i = 75"
+    );
+    rows.extend(grazing.into_iter().map(|r| {
+        let doubtful = r.theta_o.abs() == 80.0;
+        (r, doubtful)
+    }));
+    rows
 }
 
 /// A row of slab_rt_dev.csv (iadpython adding-doubling).
@@ -118,6 +149,6 @@ pub fn ad_params(albedo: f64, tau: f64, g: f64, n: f64) -> PaperParams {
         m_b: 0.0,
         dist_f: Distribution::Ggx,
         dist_b: Distribution::Ggx,
-        face_scattering: Default::default(),
+        face_scattering: paperbsdf_core::FaceScattering::Single,
     }
 }
