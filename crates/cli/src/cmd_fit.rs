@@ -7,8 +7,8 @@
 use anyhow::{anyhow, bail, Result};
 use paperbsdf_core::Distribution;
 use paperbsdf_fit::dataset::load_dataset;
-use paperbsdf_fit::models::candidates;
 use paperbsdf_fit::measured::{directional_albedo, in_plane, sample_measured, PointFilter, Sampling};
+use paperbsdf_fit::models::candidates;
 use paperbsdf_fit::{fit, fix_params, parse_fix, FitOptions, Kind, Point};
 
 /// Arguments of `paperbsdf fit`.
@@ -97,7 +97,10 @@ pub fn run(args: FitArgs) -> Result<()> {
         load_dataset(&args.data, args.thickness).map_err(|e| anyhow!(e))?
     } else {
         if args.data.len() != 1 {
-            bail!("a measured .bsdf file is fitted on its own: give it as the only data file ({} files given)", args.data.len());
+            bail!(
+                "a measured .bsdf file is fitted on its own: give it as the only data file ({} files given)",
+                args.data.len()
+            );
         }
         if let Some(d) = args.thickness {
             if !(d > 0.0 && d.is_finite()) {
@@ -116,7 +119,7 @@ pub fn run(args: FitArgs) -> Result<()> {
             sampling.theta_i
         );
         for &t in &sampling.theta_i {
-            albedo_rows.push((t, directional_albedo(&*b, t)));
+            albedo_rows.push((t, directional_albedo(&b, t)));
         }
         paperbsdf_fit::dataset::Dataset {
             origins: vec![bsdf_files[0].clone()],
@@ -193,11 +196,16 @@ pub fn run(args: FitArgs) -> Result<()> {
     // In-plane and out-of-plane errors, on the fitted and the extrapolation points.
     let model = cands[out.variant_index].build(&out.x).map_err(|e| anyhow!(e))?;
     let (fitted, extra) = paperbsdf_fit::fitter::split_points(&ds.points, fit_theta_i.as_deref());
-    let part = |pts: &[&Point], plane: bool| -> Vec<&Point> { pts.iter().copied().filter(|p| in_plane(p) == plane).collect() };
+    fn part<'a>(pts: &[&'a Point], plane: bool) -> Vec<&'a Point> {
+        pts.iter().copied().filter(|p| in_plane(p) == plane).collect()
+    }
     let mut plane_json = serde_json::Map::new();
     for (name, plane) in [("in_plane", true), ("out_of_plane", false)] {
         let (f, e) = (part(&fitted, plane), part(&extra, plane));
-        let (rf, re) = (rms_over(model.as_ref(), &f, ds.channels), rms_over(model.as_ref(), &e, ds.channels));
+        let (rf, re) = (
+            rms_over(model.as_ref(), &f, ds.channels),
+            rms_over(model.as_ref(), &e, ds.channels),
+        );
         if f.is_empty() && e.is_empty() {
             continue;
         }
@@ -239,7 +247,11 @@ pub fn run(args: FitArgs) -> Result<()> {
     if !fixes.is_empty() {
         println!(
             "held fixed: {}",
-            fixes.iter().map(|(n, v)| format!("{n}={v}")).collect::<Vec<_>>().join(", ")
+            fixes
+                .iter()
+                .map(|(n, v)| format!("{n}={v}"))
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
     for w in &out.warnings {
@@ -250,13 +262,30 @@ pub fn run(args: FitArgs) -> Result<()> {
         let mut json = out.to_json(&ds.origins, fit_theta_i.as_deref());
         let obj = json.as_object_mut().expect("FIT.json is an object");
         obj.insert("errors_by_plane".into(), serde_json::Value::Object(plane_json));
-        obj.insert("fixed".into(), serde_json::json!(fixes.iter().map(|(n, v)| (n.clone(), *v)).collect::<serde_json::Map<String, serde_json::Value>>()));
-        obj.insert("transmission".into(), serde_json::json!(transmission_note.as_deref().unwrap_or("constrained by the transmission points of the data")));
-        obj.insert("filters".into(), serde_json::json!({"exclude_retro_deg": args.exclude_retro, "max_theta_deg": args.max_theta}));
+        obj.insert(
+            "fixed".into(),
+            serde_json::json!(fixes
+                .iter()
+                .map(|(n, v)| (n.clone(), serde_json::json!(*v)))
+                .collect::<serde_json::Map<String, serde_json::Value>>()),
+        );
+        obj.insert(
+            "transmission".into(),
+            serde_json::json!(transmission_note
+                .as_deref()
+                .unwrap_or("constrained by the transmission points of the data")),
+        );
+        obj.insert(
+            "filters".into(),
+            serde_json::json!({"exclude_retro_deg": args.exclude_retro, "max_theta_deg": args.max_theta}),
+        );
         if !albedo_rows.is_empty() {
             obj.insert(
                 "measured_albedo".into(),
-                serde_json::json!(albedo_rows.iter().map(|(t, a)| serde_json::json!({"theta_i": t, "rgb": a.0})).collect::<Vec<_>>()),
+                serde_json::json!(albedo_rows
+                    .iter()
+                    .map(|(t, a)| serde_json::json!({"theta_i": t, "rgb": a.0}))
+                    .collect::<Vec<_>>()),
             );
         }
         let text = serde_json::to_string_pretty(&json)? + "\n";

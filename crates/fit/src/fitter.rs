@@ -383,9 +383,18 @@ pub fn fit(
                     p.name, p.value, p.bounds[0], p.bounds[1], p.name.split('[').next().unwrap_or(&p.name)
                 ));
             } else if !p.determined {
+                let how = if p.stderr_unit.is_finite() {
+                    format!(
+                        "standard error {:.3e}, {:.0}% of its search range",
+                        p.stderr,
+                        100.0 * p.stderr_unit
+                    )
+                } else {
+                    "no constraint at all: it trades off exactly against other parameters".to_string()
+                };
                 warnings.push(format!(
-                    "{} = {:.6} is not determined by the data (standard error {:.3e}, {:.0}% of its search range)",
-                    p.name, p.value, p.stderr, 100.0 * p.stderr_unit.min(99.99)
+                    "{} = {:.6} is not determined by the data ({how})",
+                    p.name, p.value
                 ));
             }
         }

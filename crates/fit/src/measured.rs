@@ -64,7 +64,9 @@ impl PointFilter {
     pub fn validate(&self) -> Result<(), String> {
         if let Some(r) = self.exclude_retro_deg {
             if !(0.0..180.0).contains(&r) {
-                return Err(format!("--exclude-retro {r} is outside its allowed range [0, 180) degrees"));
+                return Err(format!(
+                    "--exclude-retro {r} is outside its allowed range [0, 180) degrees"
+                ));
             }
         }
         if let Some(m) = self.max_theta_deg {
@@ -207,13 +209,26 @@ mod tests {
         // transmission is never retro-reflection
         let (wi, wo) = in_plane_directions(30.0, 30.0, true);
         assert!(f.keeps(wi, wo));
-        assert!(PointFilter { exclude_retro_deg: Some(-1.0), max_theta_deg: None }.validate().is_err());
-        assert!(PointFilter { exclude_retro_deg: None, max_theta_deg: Some(0.0) }.validate().is_err());
+        assert!(PointFilter {
+            exclude_retro_deg: Some(-1.0),
+            max_theta_deg: None
+        }
+        .validate()
+        .is_err());
+        assert!(PointFilter {
+            exclude_retro_deg: None,
+            max_theta_deg: Some(0.0)
+        }
+        .validate()
+        .is_err());
     }
 
     #[test]
     fn default_sampling_has_480_pairs() {
         let s = Sampling::default();
-        assert_eq!(s.theta_i.len() * (s.in_plane_theta_o.len() + s.out_theta_o.len() * s.out_phi_o.len()), 480);
+        assert_eq!(
+            s.theta_i.len() * (s.in_plane_theta_o.len() + s.out_theta_o.len() * s.out_phi_o.len()),
+            480
+        );
     }
 }

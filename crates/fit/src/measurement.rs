@@ -404,12 +404,26 @@ mod tests {
     /// point four times, weight 0 not at all (against the definition in `objective`).
     #[test]
     fn weight_column_is_the_objective_weight() {
-        let m = parse_measurement("kind,theta_i_deg,theta_o_deg,f,weight\nR,30,-30,1,4\nR,30,0,2,0\nR,30,10,0.5,1\n", "w.csv").unwrap();
+        let m = parse_measurement(
+            "kind,theta_i_deg,theta_o_deg,f,weight\nR,30,-30,1,4\nR,30,0,2,0\nR,30,10,0.5,1\n",
+            "w.csv",
+        )
+        .unwrap();
         let w: Vec<f64> = m.points.iter().map(|p| crate::objective::weight(p, 0)).collect();
-        assert!((w[0] - 4.0).abs() < 1e-9 && w[1] == 0.0 && (w[2] - 1.0).abs() < 1e-9, "{w:?}");
+        assert!(
+            (w[0] - 4.0).abs() < 1e-9 && w[1] == 0.0 && (w[2] - 1.0).abs() < 1e-9,
+            "{w:?}"
+        );
         let e = parse_measurement("kind,theta_i_deg,theta_o_deg,f,weight\nR,30,-30,1,-1\n", "w.csv").unwrap_err();
-        assert!(e.to_string().contains("w.csv:2:5") && e.to_string().contains("negative weight"), "{e}");
-        let e = parse_measurement("kind,theta_i_deg,theta_o_deg,f,weight,stderr\nR,30,-30,1,1,1\n", "w.csv").unwrap_err();
+        assert!(
+            e.to_string().contains("w.csv:2:5") && e.to_string().contains("negative weight"),
+            "{e}"
+        );
+        let e = parse_measurement(
+            "kind,theta_i_deg,theta_o_deg,f,weight,stderr\nR,30,-30,1,1,1\n",
+            "w.csv",
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("both"), "{e}");
     }
 

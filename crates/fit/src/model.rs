@@ -193,7 +193,10 @@ pub fn fix_params(cands: Vec<Box<dyn FitModel>>, fixes: &[(String, f64)]) -> Res
                 }
             }
             if !hit {
-                let mut names: Vec<String> = specs.iter().map(|s| s.name.split('[').next().unwrap_or("").to_string()).collect();
+                let mut names: Vec<String> = specs
+                    .iter()
+                    .map(|s| s.name.split('[').next().unwrap_or("").to_string())
+                    .collect();
                 names.dedup();
                 return Err(format!(
                     "--fix {name}={v}: model `{}` has no fitted parameter `{name}` (fitted parameters: {}; the thickness is --thickness)",
@@ -205,7 +208,12 @@ pub fn fix_params(cands: Vec<Box<dyn FitModel>>, fixes: &[(String, f64)]) -> Res
         if let Err(e) = c.build(&base) {
             return Err(format!("--fix: the model refuses the fixed values: {e}"));
         }
-        let free: Vec<String> = specs.iter().zip(&fixed).filter(|(_, f)| !**f).map(|(s, _)| s.name.clone()).collect();
+        let free: Vec<String> = specs
+            .iter()
+            .zip(&fixed)
+            .filter(|(_, f)| !**f)
+            .map(|(s, _)| s.name.clone())
+            .collect();
         if free.is_empty() {
             return Err("--fix holds every parameter: nothing is left to fit".into());
         }

@@ -69,7 +69,13 @@ pub struct Identifiability {
 
 /// The report for model `c` at unit coordinates `u`, fitted to `points` with
 /// normalised residual weights `sqrt_w` ([`crate::objective::sqrt_weights`]).
-pub fn identifiability(c: &dyn FitModel, u: &[f64], points: &[&Point], sqrt_w: &[f64], channels: usize) -> Option<Identifiability> {
+pub fn identifiability(
+    c: &dyn FitModel,
+    u: &[f64],
+    points: &[&Point],
+    sqrt_w: &[f64],
+    channels: usize,
+) -> Option<Identifiability> {
     let specs = c.specs();
     let p = specs.len();
     let n = sqrt_w.len();
@@ -158,7 +164,10 @@ pub fn check_data(points: &[&Point], channels: usize, free_params: usize) -> Res
     if points.iter().all(|p| (0..channels).all(|c| p.f.0[c] == 0.0)) {
         return Err("every measured value is zero: there is no signal to fit".into());
     }
-    if points.iter().all(|p| (0..channels).all(|c| crate::objective::weight(p, c) == 0.0)) {
+    if points
+        .iter()
+        .all(|p| (0..channels).all(|c| crate::objective::weight(p, c) == 0.0))
+    {
         return Err("every point has weight zero: nothing would be fitted".into());
     }
     Ok(())

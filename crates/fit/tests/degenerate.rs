@@ -62,9 +62,18 @@ fn fit_on_a_bound_warns() {
     }
     let out = run(&csv, "lambert-glass").unwrap();
     let id = out.identifiability.as_ref().expect("report");
-    let on_bound: Vec<&str> = id.params.iter().filter(|p| p.on_bound).map(|p| p.name.as_str()).collect();
+    let on_bound: Vec<&str> = id
+        .params
+        .iter()
+        .filter(|p| p.on_bound)
+        .map(|p| p.name.as_str())
+        .collect();
     assert!(!on_bound.is_empty(), "{:?}", id.params);
     for n in &on_bound {
-        assert!(out.warnings.iter().any(|w| w.contains(n) && w.contains("bound")), "{n}: {:?}", out.warnings);
+        assert!(
+            out.warnings.iter().any(|w| w.contains(n) && w.contains("bound")),
+            "{n}: {:?}",
+            out.warnings
+        );
     }
 }

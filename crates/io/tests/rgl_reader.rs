@@ -7,12 +7,14 @@
 //! so agreement is expected to about 1e-6 relative away from the grid's
 //! clamping edges.
 
-use paperbsdf_io::MeasuredBsdf;
 use paperbsdf_core::DVec3;
+use paperbsdf_io::MeasuredBsdf;
 use std::path::PathBuf;
 
 fn rgl(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/reference/rgl").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data/reference/rgl")
+        .join(name)
 }
 
 fn rows(name: &str) -> Vec<(DVec3, DVec3, [f64; 3])> {
@@ -21,7 +23,11 @@ fn rows(name: &str) -> Vec<(DVec3, DVec3, [f64; 3])> {
         .filter(|l| !l.starts_with('#') && !l.starts_with("wi_x"))
         .map(|l| {
             let v: Vec<f64> = l.split(',').map(|s| s.parse().unwrap()).collect();
-            (DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5]), [v[6], v[7], v[8]])
+            (
+                DVec3::new(v[0], v[1], v[2]),
+                DVec3::new(v[3], v[4], v[5]),
+                [v[6], v[7], v[8]],
+            )
         })
         .collect()
 }
@@ -51,7 +57,11 @@ fn compare(stem: &str) {
         }
     }
     let frac = within1 as f64 / n as f64;
-    println!("{stem}: {within1}/{n} values ({:.2}%) within 1% or 1e-4; worst {:.3e} relative at {worst_at}", 100.0 * frac, worst);
+    println!(
+        "{stem}: {within1}/{n} values ({:.2}%) within 1% or 1e-4; worst {:.3e} relative at {worst_at}",
+        100.0 * frac,
+        worst
+    );
     assert!(frac >= 0.99, "{stem}: only {:.2}% within 1%", 100.0 * frac);
     assert!(worst <= 0.05, "{stem}: worst {worst} at {worst_at}");
 }
@@ -101,7 +111,10 @@ fn truncated_files_are_refused() {
     let full = satin_bytes();
     for cut in [5usize, 14, 17, 30, 200, 411, 1000, 300_000, full.len() - 1] {
         let e = err_of(full[..cut].to_vec());
-        assert!(e.contains("bad.bsdf") && (e.contains("truncated") || e.contains("not a tensor file")), "cut {cut}: {e}");
+        assert!(
+            e.contains("bad.bsdf") && (e.contains("truncated") || e.contains("not a tensor file")),
+            "cut {cut}: {e}"
+        );
     }
     // a cut in the data names the field that runs past the end
     let e = err_of(full[..full.len() - 1].to_vec());
@@ -186,7 +199,10 @@ fn corrupted_headers_never_panic() {
             let mut b = full.clone();
             b[pos] = v;
             if let Ok(m) = MeasuredBsdf::from_bytes(b, "x") {
-                let _ = m.eval_raw(DVec3::new(0.2, 0.1, 0.97).normalize(), DVec3::new(-0.3, 0.0, 0.95).normalize());
+                let _ = m.eval_raw(
+                    DVec3::new(0.2, 0.1, 0.97).normalize(),
+                    DVec3::new(-0.3, 0.0, 0.95).normalize(),
+                );
             }
         }
     }
@@ -194,7 +210,9 @@ fn corrupted_headers_never_panic() {
     for len in [0usize, 13, 18, 64, 500] {
         let mut b = b"tensor_file\0\x01\x00".to_vec();
         while b.len() < len {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             b.push((state >> 33) as u8);
         }
         let _ = MeasuredBsdf::from_bytes(b, "x");

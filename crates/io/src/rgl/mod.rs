@@ -115,9 +115,11 @@ impl MeasuredBsdf {
         };
         let tf = TensorFile::parse(bytes).map_err(err)?;
         if tf.fields.contains_key("wavelengths") || tf.fields.contains_key("spectra") {
-            return Err(err("this is a spectral RGL file (fields `wavelengths`, `spectra`), which is not supported: \
+            return Err(err(
+                "this is a spectral RGL file (fields `wavelengths`, `spectra`), which is not supported: \
                  download the RGB variant of the material (`..._rgb.bsdf`) from the RGL database"
-                .into()));
+                    .into(),
+            ));
         }
         let shape = |name: &str, rank: usize| -> Result<Vec<usize>, DataError> {
             let f = tf.field(name).map_err(err)?;
@@ -151,7 +153,11 @@ impl MeasuredBsdf {
             want("luminance", &lum_s, format!("[{np}, {nt}, n, n]"))?;
         }
         if rgb_s[0] != np || rgb_s[1] != nt || rgb_s[2] != 3 || rgb_s[3] != rgb_s[4] || rgb_s[3] != lum_s[2] {
-            want("rgb", &rgb_s, format!("[{np}, {nt}, 3, {n}, {n}] (n from `luminance`)", n = lum_s[2]))?;
+            want(
+                "rgb",
+                &rgb_s,
+                format!("[{np}, {nt}, 3, {n}, {n}] (n from `luminance`)", n = lum_s[2]),
+            )?;
         }
         if jac.dtype != DType::U8 && jac.dtype != DType::I8 || jac.len != 1 {
             return Err(err(format!(
@@ -161,7 +167,10 @@ impl MeasuredBsdf {
             )));
         }
         if desc.dtype.size() != 1 {
-            return Err(err(format!("field `description` must be bytes, found {}", desc.dtype.name())));
+            return Err(err(format!(
+                "field `description` must be bytes, found {}",
+                desc.dtype.name()
+            )));
         }
         let description = String::from_utf8_lossy(tf.bytes(desc)).into_owned();
         let jacobian = tf.bytes(jac)[0] != 0;
@@ -180,8 +189,10 @@ impl MeasuredBsdf {
         let bad = |name: &'static str| move |m: String| err(format!("field `{name}`: {m}"));
         let params = vec![phi.clone(), theta.clone()];
         let ndf = Warp2D::new(&floats("ndf")?, ndf_s[1], ndf_s[0], vec![], false, false).map_err(bad("ndf"))?;
-        let sigma = Warp2D::new(&floats("sigma")?, sigma_s[1], sigma_s[0], vec![], false, false).map_err(bad("sigma"))?;
-        let vndf = Warp2D::new(&floats("vndf")?, vndf_s[3], vndf_s[2], params.clone(), true, true).map_err(bad("vndf"))?;
+        let sigma =
+            Warp2D::new(&floats("sigma")?, sigma_s[1], sigma_s[0], vec![], false, false).map_err(bad("sigma"))?;
+        let vndf =
+            Warp2D::new(&floats("vndf")?, vndf_s[3], vndf_s[2], params.clone(), true, true).map_err(bad("vndf"))?;
         let mut p3 = params;
         p3.push(vec![0.0, 1.0, 2.0]);
         let rgb = Warp2D::new(&floats("rgb")?, rgb_s[4], rgb_s[3], p3, false, false).map_err(bad("rgb"))?;
@@ -244,7 +255,11 @@ impl MeasuredBsdf {
         let mut scale = 1.0 / wo.z;
         if self.jacobian {
             let s = self.sigma.eval(u_wi, &[]);
-            scale *= if s > 0.0 { self.ndf.eval(u_m, &[]) / (4.0 * s) } else { 0.0 };
+            scale *= if s > 0.0 {
+                self.ndf.eval(u_m, &[]) / (4.0 * s)
+            } else {
+                0.0
+            };
         }
         Rgb(out.map(|v| v * scale))
     }

@@ -169,41 +169,57 @@ impl TensorFile {
         }
         if bytes.len() < 18 || &bytes[..12] != MAGIC {
             if bytes.len() >= 12 && &bytes[..12] == MAGIC {
-                return Err(format!("truncated header: {} bytes, a tensor file header has at least 18", bytes.len()));
+                return Err(format!(
+                    "truncated header: {} bytes, a tensor file header has at least 18",
+                    bytes.len()
+                ));
             }
-            return Err("not a tensor file: it does not start with the magic bytes `tensor_file\\0` \
+            return Err(
+                "not a tensor file: it does not start with the magic bytes `tensor_file\\0` \
                  (RGL material files are `.bsdf` tensor files)"
-                .into());
+                    .into(),
+            );
         }
         let mut c = Cursor { b: &bytes, p: 12 };
         let ver = c.take(2, "version")?;
         if ver != [1, 0] {
-            return Err(format!("unknown tensor file version {}.{} (only 1.0 is known)", ver[0], ver[1]));
+            return Err(format!(
+                "unknown tensor file version {}.{} (only 1.0 is known)",
+                ver[0], ver[1]
+            ));
         }
         let n = c.u32("field count")? as usize;
         // Each field header has at least 2 + 2 + 1 + 8 bytes: a count the file cannot hold is refused before any allocation.
         if n > bytes.len() / 13 {
-            return Err(format!("truncated or corrupt header: it declares {n} fields, more than a file of {} bytes can hold", bytes.len()));
+            return Err(format!(
+                "truncated or corrupt header: it declares {n} fields, more than a file of {} bytes can hold",
+                bytes.len()
+            ));
         }
         let mut fields = BTreeMap::new();
         for k in 0..n {
             let len = c.u16(&format!("name length of field {k}"))? as usize;
             let name_bytes = c.take(len, &format!("name of field {k}"))?;
-            let name = String::from_utf8(name_bytes.to_vec())
-                .map_err(|_| format!("the name of field {k} is not UTF-8"))?;
+            let name =
+                String::from_utf8(name_bytes.to_vec()).map_err(|_| format!("the name of field {k} is not UTF-8"))?;
             let ndim = c.u16(&format!("rank of field `{name}`"))? as usize;
             let code = c.take(1, &format!("type of field `{name}`"))?[0];
-            let dtype = DType::from_code(code).ok_or_else(|| format!("field `{name}` has an unknown element type code {code}"))?;
+            let dtype = DType::from_code(code)
+                .ok_or_else(|| format!("field `{name}` has an unknown element type code {code}"))?;
             let offset = c.u64(&format!("offset of field `{name}`"))?;
             // the shape bytes must be present before the vector is allocated
             if ndim.checked_mul(8).is_none_or(|s| c.p + s > bytes.len()) {
-                return Err(format!("truncated header: the shape of field `{name}` (rank {ndim}) runs past the end of the file"));
+                return Err(format!(
+                    "truncated header: the shape of field `{name}` (rank {ndim}) runs past the end of the file"
+                ));
             }
             let mut shape = Vec::with_capacity(ndim);
             let mut count: u64 = 1;
             for _ in 0..ndim {
                 let s = c.u64(&format!("shape of field `{name}`"))?;
-                count = count.checked_mul(s).ok_or_else(|| format!("field `{name}`: shape overflows"))?;
+                count = count
+                    .checked_mul(s)
+                    .ok_or_else(|| format!("field `{name}`: shape overflows"))?;
                 shape.push(s as usize);
             }
             let nbytes = count

@@ -41,7 +41,14 @@ impl Warp2D {
     /// is scaled to integrate to one over the unit square; with `cdf`, the
     /// tables for [`Warp2D::invert`] are built. Errors on a shape mismatch, a
     /// grid smaller than 2 x 2 or a parameter grid that does not increase.
-    pub fn new(data: &[f32], w: usize, h: usize, params: Vec<Vec<f64>>, normalize: bool, cdf: bool) -> Result<Warp2D, String> {
+    pub fn new(
+        data: &[f32],
+        w: usize,
+        h: usize,
+        params: Vec<Vec<f64>>,
+        normalize: bool,
+        cdf: bool,
+    ) -> Result<Warp2D, String> {
         if w < 2 || h < 2 {
             return Err(format!("a {w} x {h} grid is too small (at least 2 x 2)"));
         }
@@ -231,7 +238,10 @@ mod tests {
         let w = Warp2D::new(&[2.0; 12], 4, 3, vec![], true, true).unwrap();
         for &p in &[[0.0, 0.0], [0.3, 0.7], [1.0, 1.0], [0.99, 0.01]] {
             let (q, pdf) = w.invert(p, &[]);
-            assert!((q[0] - p[0]).abs() < 1e-12 && (q[1] - p[1]).abs() < 1e-12, "{p:?} -> {q:?}");
+            assert!(
+                (q[0] - p[0]).abs() < 1e-12 && (q[1] - p[1]).abs() < 1e-12,
+                "{p:?} -> {q:?}"
+            );
             assert!((pdf - 1.0).abs() < 1e-12);
         }
     }
@@ -257,7 +267,13 @@ mod tests {
         d.extend([3.0f32; 4]);
         let w = Warp2D::new(&d, 2, 2, vec![vec![0.0, 1.0]], false, false).unwrap();
         assert!((w.eval([0.2, 0.2], &[0.5]) - 2.0).abs() < 1e-12);
-        assert!((w.eval([0.2, 0.2], &[-3.0]) - 1.0).abs() < 1e-12, "clamped below the grid");
-        assert!((w.eval([0.2, 0.2], &[7.0]) - 3.0).abs() < 1e-12, "clamped above the grid");
+        assert!(
+            (w.eval([0.2, 0.2], &[-3.0]) - 1.0).abs() < 1e-12,
+            "clamped below the grid"
+        );
+        assert!(
+            (w.eval([0.2, 0.2], &[7.0]) - 3.0).abs() < 1e-12,
+            "clamped above the grid"
+        );
     }
 }
