@@ -365,7 +365,7 @@ pub fn fit(
     let model = c.build(&x).map_err(FitError::NoValidStart)?;
     let (rms, rms_u) = rms_log_error(model.as_ref(), &fitted, channels).unwrap();
     let extra_rms = rms_log_error(model.as_ref(), &extra, channels).map(|e| e.0);
-    if !(rms <= MEANINGLESS_RMS) {
+    if rms.is_nan() || rms > MEANINGLESS_RMS {
         return Err(FitError::Meaningless {
             variant: c.variant(),
             rms,

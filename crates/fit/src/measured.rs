@@ -151,7 +151,7 @@ pub fn directional_albedo(b: &dyn Bsdf, theta_i_deg: f64) -> Rgb {
         for j in 0..np {
             let phi = std::f64::consts::TAU * (j as f64 + 0.5) / np as f64;
             let wo = DVec3::new(st * phi.cos(), st * phi.sin(), mu);
-            sum = sum + b.eval(wi, wo);
+            sum += b.eval(wi, wo);
         }
     }
     // int f cos dw = pi * mean of f over the cosine-weighted measure

@@ -232,10 +232,10 @@ pub fn parse_measurement(text: &str, origin: &str) -> Result<Measurement, Measur
                 vec![]
             };
             let weight = find("weight");
-            if weight.is_some() && !stderr.is_empty() {
+            if let (Some(wcol), false) = (weight, stderr.is_empty()) {
                 return Err(at(
                     ln,
-                    weight.unwrap() + 1,
+                    wcol + 1,
                     "header has both `weight` and `stderr` columns: give one of them".into(),
                 ));
             }

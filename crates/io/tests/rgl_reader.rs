@@ -40,8 +40,7 @@ fn compare(stem: &str) {
     let (mut within1, mut n, mut worst, mut worst_at) = (0usize, 0usize, 0.0f64, String::new());
     for (wi, wo, m) in &rows {
         let f = b.eval_raw(*wi, *wo);
-        for c in 0..3 {
-            let (ours, theirs) = (f.0[c], m[c]);
+        for (c, (&ours, &theirs)) in f.0.iter().zip(m.iter()).enumerate() {
             let abs = (ours - theirs).abs();
             let rel = abs / theirs.abs().max(1e-300);
             n += 1;

@@ -181,7 +181,7 @@ impl MeasuredBsdf {
         let mut reduction = 0;
         if !isotropic {
             let span = phi[np - 1] - phi[0];
-            if !(span > 0.0) {
+            if span.is_nan() || span <= 0.0 {
                 return Err(err(format!("field `phi_i` does not increase: {phi:?}")));
             }
             reduction = (2.0 * PI / span).round() as i32;

@@ -58,7 +58,10 @@ impl Warp2D {
             if p.is_empty() {
                 return Err("a parameter grid is empty".into());
             }
-            if p.windows(2).any(|v| !(v[1] > v[0])) || p.iter().any(|v| !v.is_finite()) {
+            if p.windows(2)
+                .any(|v| v[1].partial_cmp(&v[0]) != Some(std::cmp::Ordering::Greater))
+                || p.iter().any(|v| !v.is_finite())
+            {
                 return Err("a parameter grid is not strictly increasing and finite".into());
             }
             strides[i] = if p.len() > 1 { slices } else { 0 };
@@ -95,7 +98,7 @@ impl Warp2D {
                     marg.push(acc);
                 }
                 if normalize {
-                    if !(acc > 0.0) {
+                    if acc.is_nan() || acc <= 0.0 {
                         return Err(format!("slice {s} has no positive integral and cannot be normalised"));
                     }
                     norm = 1.0 / acc;
@@ -110,7 +113,7 @@ impl Warp2D {
                         sum += d[i] as f64 + d[i + 1] as f64 + d[i + w] as f64 + d[i + w + 1] as f64;
                     }
                 }
-                if !(sum > 0.0) {
+                if sum.is_nan() || sum <= 0.0 {
                     return Err(format!("slice {s} has no positive integral and cannot be normalised"));
                 }
                 norm = 1.0 / (sx * sy * sum);
