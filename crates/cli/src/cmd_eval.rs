@@ -9,10 +9,10 @@ use paperbsdf_io::models::{load_model, LoadedModel};
 /// Arguments of `paperbsdf eval`.
 #[derive(clap::Args, Debug)]
 pub struct EvalArgs {
-    /// Model name: rough-dielectric, paper, reduced-multilayer, lambert-glass.
+    /// Model name: rough-dielectric, paper, reduced-multilayer, lambert-glass, or measured (with --params FILE.bsdf, an RGL measured file).
     #[arg(long)]
     pub model: String,
-    /// Parameters: a JSON or TOML file, or inline JSON (`'{"eta":1.5,...}'`).
+    /// Parameters: a JSON or TOML file, or inline JSON (`'{"eta":1.5,...}'`); for `measured`, the `.bsdf` file.
     #[arg(long)]
     pub params: String,
     /// CSV file of direction pairs (columns wi_x,wi_y,wi_z,wo_x,wo_y,wo_z; others are echoed).

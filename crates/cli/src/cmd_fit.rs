@@ -1,16 +1,20 @@
 //! `paperbsdf fit`: fits a model to in-plane (or general) BSDF measurements
-//! (DESIGN.md section 5; crate paperbsdf-fit) and writes FIT.json.
+//! (DESIGN.md section 5; crate paperbsdf-fit) or to a measured RGL `.bsdf`
+//! file (sampled in and out of the plane of incidence,
+//! [`paperbsdf_fit::measured`]), and writes FIT.json with the errors, what the
+//! data determine, and warnings.
 
 use anyhow::{anyhow, bail, Result};
 use paperbsdf_core::{Distribution, FaceScattering};
 use paperbsdf_fit::dataset::load_dataset;
+use paperbsdf_fit::measured::{directional_albedo, in_plane, sample_measured, PointFilter, Sampling};
 use paperbsdf_fit::models::candidates_with_faces;
-use paperbsdf_fit::{fit, FitOptions};
+use paperbsdf_fit::{fit, fix_params, parse_fix, FitOptions, Kind, Point};
 
 /// Arguments of `paperbsdf fit`.
 #[derive(clap::Args, Debug)]
 pub struct FitArgs {
-    /// Measurement files (CSV: kind,theta_i_deg,theta_o_deg or wi_*,wo_* columns; f or r,g,b; optional stderr).
+    /// Measurement files (CSV: kind,theta_i_deg,theta_o_deg or wi_*,wo_* columns; f or r,g,b; optional stderr or weight), or one measured RGL `.bsdf` file.
     #[arg(required = true)]
     pub data: Vec<String>,
     /// Model: paper, lambert-glass or reduced-multilayer.
@@ -44,6 +48,24 @@ pub struct FitArgs {
     /// `single` (Walter's single-scattering faces, as in the paper and Mitsuba's roughdielectric).
     #[arg(long = "face-scattering", default_value = "multiple", value_parser = parse_face_scattering)]
     pub face_scattering: FaceScattering,
+    /// Hold a parameter at a value (repeatable): e.g. `--fix eta_f=1.5 --fix m_b=0.4`; a colour parameter's name fixes all its channels.
+    #[arg(long = "fix", value_name = "NAME=VALUE")]
+    pub fix: Vec<String>,
+    /// Leave out reflection points whose viewer is within DEG degrees of the light (where a goniometer's detector blocks the light).
+    #[arg(long = "exclude-retro", value_name = "DEG")]
+    pub exclude_retro: Option<f64>,
+    /// Leave out points whose light or viewer is more than DEG degrees from the normal (unreliable grazing measurements).
+    #[arg(long = "max-theta", value_name = "DEG")]
+    pub max_theta: Option<f64>,
+}
+
+/// Whether `path` names a measured RGL file (by extension).
+pub fn is_bsdf_file(path: &str) -> bool {
+    path.to_ascii_lowercase().ends_with(".bsdf")
+}
+
+fn rms_over(model: &dyn paperbsdf_fit::Evaluable, pts: &[&Point], channels: usize) -> Option<f64> {
+    paperbsdf_fit::objective::rms_log_error(model, pts, channels).map(|e| e.0)
 }
 
 fn parse_face_scattering(s: &str) -> Result<FaceScattering, String> {
@@ -66,7 +88,84 @@ pub fn run(args: FitArgs) -> Result<()> {
         bail!("--samples, --starts and --max-iter must be at least 1");
     }
     let dists = parse_dists(&args.dists)?;
-    let ds = load_dataset(&args.data, args.thickness).map_err(|e| anyhow!(e))?;
+    let filter = PointFilter {
+        exclude_retro_deg: args.exclude_retro,
+        max_theta_deg: args.max_theta,
+    };
+    filter.validate().map_err(|e| anyhow!(e))?;
+    let fixes = args
+        .fix
+        .iter()
+        .map(|f| parse_fix(f))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| anyhow!(e))?;
+    let bsdf_files: Vec<&String> = args.data.iter().filter(|p| is_bsdf_file(p)).collect();
+    let mut albedo_rows: Vec<(f64, paperbsdf_core::Rgb)> = Vec::new();
+    let mut ds = if bsdf_files.is_empty() {
+        load_dataset(&args.data, args.thickness).map_err(|e| anyhow!(e))?
+    } else {
+        if args.data.len() != 1 {
+            bail!(
+                "a measured .bsdf file is fitted on its own: give it as the only data file ({} files given)",
+                args.data.len()
+            );
+        }
+        if let Some(d) = args.thickness {
+            if !(d > 0.0 && d.is_finite()) {
+                bail!("--thickness {d} is outside its allowed range (0, inf) mm");
+            }
+        }
+        let b = paperbsdf_io::MeasuredBsdf::load(bsdf_files[0])?;
+        let sampling = Sampling::default();
+        println!(
+            "{}: \"{}\", {} incident elevations x {} azimuths; sampled at {} direction pairs (theta_i {:?}, in-plane and out-of-plane viewers)",
+            bsdf_files[0],
+            b.description,
+            b.theta_i.len(),
+            b.phi_i.len(),
+            sampling.theta_i.len() * (sampling.in_plane_theta_o.len() + sampling.out_theta_o.len() * sampling.out_phi_o.len()),
+            sampling.theta_i
+        );
+        for &t in &sampling.theta_i {
+            albedo_rows.push((t, directional_albedo(&b, t)));
+        }
+        paperbsdf_fit::dataset::Dataset {
+            origins: vec![bsdf_files[0].clone()],
+            points: sample_measured(&b, &sampling),
+            channels: 3,
+            thickness: args.thickness,
+            params_header: None,
+        }
+    };
+    let before = ds.points.len();
+    ds.points = filter.apply(std::mem::take(&mut ds.points));
+    if ds.points.len() < before {
+        println!(
+            "left out {} of {before} points (--exclude-retro {:?}, --max-theta {:?})",
+            before - ds.points.len(),
+            args.exclude_retro,
+            args.max_theta
+        );
+    }
+    if !albedo_rows.is_empty() {
+        println!("measured directional albedo (int f cos dwo over the upper hemisphere; r, g, b):");
+        let mut brighter = Vec::new();
+        for (t, a) in &albedo_rows {
+            println!("  theta_i={t:>5}: {:.4}, {:.4}, {:.4}", a.0[0], a.0[1], a.0[2]);
+            for (c, name) in ["red", "green", "blue"].iter().enumerate() {
+                if a.0[c] > 1.0 {
+                    brighter.push(format!("{name} {:.3} at theta_i {t}", a.0[c]));
+                }
+            }
+        }
+        if !brighter.is_empty() {
+            eprintln!(
+                "warning: the data reflect more than all the light that arrives ({}): no non-fluorescent slab can do that. \
+                 Fluorescent whitening agents (common in white paper) re-emit absorbed ultraviolet as blue; the Paper BSDF cannot fit that excess",
+                brighter.join(", ")
+            );
+        }
+    }
     let cands = candidates_with_faces(
         &args.model,
         ds.thickness,
@@ -75,6 +174,7 @@ pub fn run(args: FitArgs) -> Result<()> {
         args.face_scattering,
     )
     .map_err(|e| anyhow!(e))?;
+    let cands = fix_params(cands, &fixes).map_err(|e| anyhow!(e))?;
     let fit_theta_i = (!args.fit_theta_i.is_empty()).then(|| args.fit_theta_i.clone());
     let opts = FitOptions {
         global_samples: args.samples,
@@ -108,9 +208,101 @@ pub fn run(args: FitArgs) -> Result<()> {
             if g.extrapolation { " (extrapolation)" } else { "" }
         );
     }
+    // In-plane and out-of-plane errors, on the fitted and the extrapolation points.
+    let model = cands[out.variant_index].build(&out.x).map_err(|e| anyhow!(e))?;
+    let (fitted, extra) = paperbsdf_fit::fitter::split_points(&ds.points, fit_theta_i.as_deref());
+    fn part<'a>(pts: &[&'a Point], plane: bool) -> Vec<&'a Point> {
+        pts.iter().copied().filter(|p| in_plane(p) == plane).collect()
+    }
+    let mut plane_json = serde_json::Map::new();
+    for (name, plane) in [("in_plane", true), ("out_of_plane", false)] {
+        let (f, e) = (part(&fitted, plane), part(&extra, plane));
+        let (rf, re) = (
+            rms_over(model.as_ref(), &f, ds.channels),
+            rms_over(model.as_ref(), &e, ds.channels),
+        );
+        if f.is_empty() && e.is_empty() {
+            continue;
+        }
+        println!(
+            "{name}: rms_log_error {} on {} fitted points, {} on {} extrapolation points",
+            rf.map(|v| format!("{v:.5}")).unwrap_or("-".into()),
+            f.len(),
+            re.map(|v| format!("{v:.5}")).unwrap_or("-".into()),
+            e.len()
+        );
+        plane_json.insert(
+            name.into(),
+            serde_json::json!({"rms_log_error": rf, "points": f.len(), "extrapolation_rms_log_error": re, "extrapolation_points": e.len()}),
+        );
+    }
+    let reflection_only = ds.points.iter().all(|p| p.kind == Kind::R);
+    let transmission_note = reflection_only.then(|| {
+        "the data are reflection only: transmission is not constrained by them; the transmission of the fitted parameters is a prediction".to_string()
+    });
+    if let Some(n) = &transmission_note {
+        println!("note: {n}");
+    }
+    if let Some(id) = &out.identifiability {
+        println!(
+            "what the data determine ({} values, {} free parameters; {} undetermined combination(s)):",
+            id.values, id.free_params, id.undetermined_combinations
+        );
+        for p in &id.params {
+            let status = if p.on_bound {
+                "ON BOUND"
+            } else if p.determined {
+                "determined"
+            } else {
+                "not determined"
+            };
+            println!("  {:<12} {:>12.6} +- {:<10.3e} {status}", p.name, p.value, p.stderr);
+        }
+    }
+    if !fixes.is_empty() {
+        println!(
+            "held fixed: {}",
+            fixes
+                .iter()
+                .map(|(n, v)| format!("{n}={v}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    for w in &out.warnings {
+        eprintln!("warning: {w}");
+    }
     println!("seconds: {:.2}", out.seconds);
     if let Some(path) = &args.out {
-        let json = out.to_json(&ds.origins, fit_theta_i.as_deref());
+        let mut json = out.to_json(&ds.origins, fit_theta_i.as_deref());
+        let obj = json.as_object_mut().expect("FIT.json is an object");
+        obj.insert("errors_by_plane".into(), serde_json::Value::Object(plane_json));
+        obj.insert(
+            "fixed".into(),
+            serde_json::json!(fixes
+                .iter()
+                .map(|(n, v)| (n.clone(), serde_json::json!(*v)))
+                .collect::<serde_json::Map<String, serde_json::Value>>()),
+        );
+        obj.insert(
+            "transmission".into(),
+            serde_json::json!(transmission_note
+                .as_deref()
+                .unwrap_or("constrained by the transmission points of the data")),
+        );
+        obj.insert(
+            "filters".into(),
+            serde_json::json!({"exclude_retro_deg": args.exclude_retro, "max_theta_deg": args.max_theta}),
+        );
+        if !albedo_rows.is_empty() {
+            obj.insert(
+                "measured_albedo".into(),
+                serde_json::json!(albedo_rows
+                    .iter()
+                    .map(|(t, a)| serde_json::json!({"theta_i": t, "rgb": a.0}))
+                    .collect::<Vec<_>>()),
+            );
+        }
         let text = serde_json::to_string_pretty(&json)? + "\n";
         paperbsdf_io::write_atomic(path, text.as_bytes())?;
         println!("wrote {path}");

@@ -6,6 +6,7 @@
 
 use clap::{Parser, Subcommand};
 
+mod cmd_convert;
 mod cmd_eval;
 mod cmd_fit;
 mod cmd_plot;
@@ -28,8 +29,10 @@ enum Command {
     Albedo(cmd_eval::AlbedoArgs),
     /// Ground truth: Monte Carlo simulation of the physical paper slab.
     Simulate(cmd_simulate::SimulateArgs),
-    /// Fit a model to in-plane BSDF measurements.
+    /// Fit a model to in-plane BSDF measurements or a measured RGL .bsdf file.
     Fit(cmd_fit::FitArgs),
+    /// Sample a measured RGL .bsdf file on in-plane angles into the measurement CSV that fit and plot read.
+    Convert(cmd_convert::ConvertArgs),
     /// In-plane plots of measurements and models, like the supplement's figures.
     Plot(cmd_plot::PlotArgs),
     /// Render a paper scene (a TOML scene file or a built-in scene name).
@@ -43,6 +46,7 @@ fn main() {
         Command::Albedo(a) => cmd_eval::run_albedo(a),
         Command::Simulate(a) => cmd_simulate::run(a),
         Command::Fit(a) => cmd_fit::run(a),
+        Command::Convert(a) => cmd_convert::run(a),
         Command::Plot(a) => cmd_plot::run(a),
         Command::Render(a) => cmd_render::run(a),
     };

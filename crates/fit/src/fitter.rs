@@ -8,6 +8,7 @@ use crate::measurement::{Kind, Point};
 use crate::model::{Evaluable, FitModel};
 use crate::objective::{residuals, rms_log_error, sqrt_weights};
 use crate::optimize::{levenberg_marquardt, LmSettings, Stop};
+use crate::report::{check_data, identifiability, Identifiability, MEANINGLESS_RMS};
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
@@ -101,6 +102,10 @@ pub struct FitOutcome {
     pub seconds: f64,
     /// Why the winning refinement stopped.
     pub stop: Stop,
+    /// What the data determine ([`crate::report`]); `None` if the Jacobian could not be evaluated.
+    pub identifiability: Option<Identifiability>,
+    /// Warnings about the result (parameters on bounds, undetermined parameters).
+    pub warnings: Vec<String>,
 }
 
 /// Why a fit failed.
@@ -118,6 +123,21 @@ pub enum FitError {
         iterations: usize,
         /// Error reached.
         rms: f64,
+    },
+    /// The data cannot determine the parameters (too few values, no signal, no weight).
+    #[error("the data cannot determine a fit: {0}")]
+    Degenerate(String),
+    /// The best fit misses the data so badly that its parameters mean nothing.
+    #[error("the best fit ({variant}) misses the data by a factor {factor:.3e} on average (RMS log error {rms:.3}, above {limit}): the model cannot represent these data, so no parameters are written. Check the units (f without the cosine, 1/sr) and the values")]
+    Meaningless {
+        /// Variant of the best fit.
+        variant: String,
+        /// Its RMS log error.
+        rms: f64,
+        /// exp(rms).
+        factor: f64,
+        /// The limit [`crate::report::MEANINGLESS_RMS`].
+        limit: f64,
     },
     /// The model could not be evaluated anywhere.
     #[error("the model could not be evaluated at any starting point: {0}")]
@@ -180,6 +200,8 @@ pub fn fit(
         };
         return Err(FitError::NoPoints(why));
     }
+    let free = candidates.iter().map(|c| c.specs().len()).max().unwrap_or(0);
+    check_data(&fitted, channels, free).map_err(FitError::Degenerate)?;
     let sw = sqrt_weights(&fitted, channels);
     let m = sw.len();
     let resid_for = |c: &dyn FitModel, u: &[f64], out: &mut [f64]| -> bool {
@@ -343,6 +365,40 @@ pub fn fit(
     let model = c.build(&x).map_err(FitError::NoValidStart)?;
     let (rms, rms_u) = rms_log_error(model.as_ref(), &fitted, channels).unwrap();
     let extra_rms = rms_log_error(model.as_ref(), &extra, channels).map(|e| e.0);
+    if rms.is_nan() || rms > MEANINGLESS_RMS {
+        return Err(FitError::Meaningless {
+            variant: c.variant(),
+            rms,
+            factor: rms.exp(),
+            limit: MEANINGLESS_RMS,
+        });
+    }
+    let ident = identifiability(c, &best.u, &fitted, &sw, channels);
+    let mut warnings = Vec::new();
+    if let Some(id) = &ident {
+        for p in &id.params {
+            if p.on_bound {
+                warnings.push(format!(
+                    "{} = {:.6} ended on a bound of its search range [{}, {}]: the data push it beyond what the model allows; its value is not a measurement (hold it with --fix {}=VALUE)",
+                    p.name, p.value, p.bounds[0], p.bounds[1], p.name.split('[').next().unwrap_or(&p.name)
+                ));
+            } else if !p.determined {
+                let how = if p.stderr_unit.is_finite() {
+                    format!(
+                        "standard error {:.3e}, {:.0}% of its search range",
+                        p.stderr,
+                        100.0 * p.stderr_unit
+                    )
+                } else {
+                    "no constraint at all: it trades off exactly against other parameters".to_string()
+                };
+                warnings.push(format!(
+                    "{} = {:.6} is not determined by the data ({how})",
+                    p.name, p.value
+                ));
+            }
+        }
+    }
     Ok(FitOutcome {
         model: c.model_name().to_string(),
         variant: c.variant(),
@@ -357,6 +413,8 @@ pub fn fit(
         evaluations,
         seconds: t0.elapsed().as_secs_f64(),
         stop: best.stop,
+        identifiability: ident,
+        warnings,
     })
 }
 
@@ -379,6 +437,8 @@ impl FitOutcome {
             "points": {"fitted": self.counts.0, "extrapolation": self.counts.1},
             "evaluations": self.evaluations,
             "stop": self.stop,
+            "identifiability": self.identifiability,
+            "warnings": self.warnings,
             "error_definition": format!(
                 "sqrt(sum w r^2 / sum w), r = ln((f_model + {e}) / (f_meas + {e})), w = 1/max(stderr/(f_meas + {e}), {s})^2 when stderr is given, else 1",
                 e = crate::objective::LOG_OFFSET, s = crate::objective::SIGMA_FLOOR

@@ -10,6 +10,8 @@
 //! * [`objective`]: the log-space RMS error and its weighting;
 //! * [`optimize`]: bounded Levenberg-Marquardt in the unit cube;
 //! * [`dataset`]: several files fitted together, thickness from headers;
+//! * [`measured`]: sampling a measured `.bsdf` file, goniometer filters, measured albedo;
+//! * [`report`]: what the data determine (uncertainties, bounds) and degenerate-data checks;
 //! * [`fitter`]: global multi-start search plus local refinement, scoring of
 //!   fitted and extrapolation points.
 
@@ -17,12 +19,14 @@
 
 pub mod dataset;
 pub mod fitter;
+pub mod measured;
 pub mod measurement;
 pub mod model;
 pub mod models;
 pub mod objective;
 pub mod optimize;
+pub mod report;
 
 pub use fitter::{fit, FitError, FitOptions, FitOutcome, GroupError};
 pub use measurement::{parse_measurement, read_measurement, Kind, Measurement, MeasurementError, Point};
-pub use model::{Evaluable, FitModel, ParamSpec, Scale, Subset};
+pub use model::{fix_params, parse_fix, Evaluable, FitModel, ParamSpec, Scale, Subset};

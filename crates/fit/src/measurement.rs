@@ -12,7 +12,12 @@
 //!   local frame); the kind is `R` when both directions are on the same side.
 //!
 //! The value is one column `f` or three columns `r,g,b`; an optional standard
-//! error is one column `stderr` (all channels) or `stderr_r,stderr_g,stderr_b`.
+//! error is one column `stderr` (all channels) or `stderr_r,stderr_g,stderr_b`;
+//! instead of it, a column `weight` (>= 0, all channels) gives each point its
+//! weight in the fit directly: it is stored as the standard error
+//! `(f + e) / sqrt(weight)` that has that weight in the objective (see
+//! [`crate::objective::weight`]; weights above `1 / SIGMA_FLOOR^2` = 1e6 count
+//! as 1e6), so weight 0 leaves a point out and weight 4 counts it four times.
 //! Other columns (e.g. `samples`) are ignored. Lines starting with `#` are
 //! comments; two header comments are understood: `# params: {JSON}` (the
 //! parameters the data were made with; its `d` is the thickness) and
@@ -155,6 +160,7 @@ pub fn parse_measurement(text: &str, origin: &str) -> Result<Measurement, Measur
         idx: Vec<usize>,
         value: Vec<usize>,
         stderr: Vec<usize>,
+        weight: Option<usize>,
         width: usize,
     }
     let mut layout: Option<Layout> = None;
@@ -225,11 +231,20 @@ pub fn parse_measurement(text: &str, origin: &str) -> Result<Measurement, Measur
             } else {
                 vec![]
             };
+            let weight = find("weight");
+            if let (Some(wcol), false) = (weight, stderr.is_empty()) {
+                return Err(at(
+                    ln,
+                    wcol + 1,
+                    "header has both `weight` and `stderr` columns: give one of them".into(),
+                ));
+            }
             layout = Some(Layout {
                 in_plane,
                 idx,
                 value,
                 stderr,
+                weight,
                 width: h.len(),
             });
             header = Some(h);
@@ -321,7 +336,14 @@ pub fn parse_measurement(text: &str, origin: &str) -> Result<Measurement, Measur
         if lay.value.len() == 1 {
             f = [f[0]; 3];
         }
-        let stderr = if lay.stderr.is_empty() {
+        let stderr = if let Some(i) = lay.weight {
+            let w = num(i)?;
+            if w < 0.0 {
+                return Err(at(ln, i + 1, format!("field `weight`: negative weight {w}")));
+            }
+            let e = crate::objective::LOG_OFFSET;
+            Some(Rgb(f.map(|v| if w > 0.0 { (v + e) / w.sqrt() } else { f64::INFINITY })))
+        } else if lay.stderr.is_empty() {
             None
         } else {
             let mut s = [0.0; 3];
@@ -377,6 +399,33 @@ pub fn parse_measurement(text: &str, origin: &str) -> Result<Measurement, Measur
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A `weight` column reproduces the weight in the objective: weight 4 counts a
+    /// point four times, weight 0 not at all (against the definition in `objective`).
+    #[test]
+    fn weight_column_is_the_objective_weight() {
+        let m = parse_measurement(
+            "kind,theta_i_deg,theta_o_deg,f,weight\nR,30,-30,1,4\nR,30,0,2,0\nR,30,10,0.5,1\n",
+            "w.csv",
+        )
+        .unwrap();
+        let w: Vec<f64> = m.points.iter().map(|p| crate::objective::weight(p, 0)).collect();
+        assert!(
+            (w[0] - 4.0).abs() < 1e-9 && w[1] == 0.0 && (w[2] - 1.0).abs() < 1e-9,
+            "{w:?}"
+        );
+        let e = parse_measurement("kind,theta_i_deg,theta_o_deg,f,weight\nR,30,-30,1,-1\n", "w.csv").unwrap_err();
+        assert!(
+            e.to_string().contains("w.csv:2:5") && e.to_string().contains("negative weight"),
+            "{e}"
+        );
+        let e = parse_measurement(
+            "kind,theta_i_deg,theta_o_deg,f,weight,stderr\nR,30,-30,1,1,1\n",
+            "w.csv",
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("both"), "{e}");
+    }
 
     #[test]
     fn in_plane_directions_follow_design_convention() {

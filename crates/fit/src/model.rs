@@ -153,3 +153,72 @@ impl FitModel for Subset {
         self.inner.params_json(&self.full(x))
     }
 }
+
+/// Parses `NAME=VALUE` (the `--fix` option).
+pub fn parse_fix(s: &str) -> Result<(String, f64), String> {
+    let (n, v) = s
+        .split_once('=')
+        .ok_or_else(|| format!("--fix `{s}`: expected NAME=VALUE, e.g. --fix eta_f=1.5"))?;
+    let v: f64 = v
+        .trim()
+        .parse()
+        .map_err(|_| format!("--fix `{s}`: `{}` is not a number", v.trim()))?;
+    if !v.is_finite() {
+        return Err(format!("--fix `{s}`: the value must be finite"));
+    }
+    Ok((n.trim().to_string(), v))
+}
+
+/// Holds the parameters named in `fixes` at their values in every candidate;
+/// the rest are searched. A name matches a parameter exactly or, for colour
+/// parameters, all three channels (`sigma_a` fixes `sigma_a[0]`..`sigma_a[2]`).
+/// Errors name an unknown parameter (listing the known ones), a value the model
+/// refuses (with the model's reason), or a fit with nothing left free.
+pub fn fix_params(cands: Vec<Box<dyn FitModel>>, fixes: &[(String, f64)]) -> Result<Vec<Box<dyn FitModel>>, String> {
+    if fixes.is_empty() {
+        return Ok(cands);
+    }
+    let mut out: Vec<Box<dyn FitModel>> = Vec::new();
+    for c in cands {
+        let specs = c.specs().to_vec();
+        let mut base: Vec<f64> = specs.iter().map(|s| s.default).collect();
+        let mut fixed = vec![false; specs.len()];
+        for (name, v) in fixes {
+            let mut hit = false;
+            for (k, s) in specs.iter().enumerate() {
+                if s.name == *name || s.name.strip_prefix(name.as_str()).is_some_and(|r| r.starts_with('[')) {
+                    base[k] = *v;
+                    fixed[k] = true;
+                    hit = true;
+                }
+            }
+            if !hit {
+                let mut names: Vec<String> = specs
+                    .iter()
+                    .map(|s| s.name.split('[').next().unwrap_or("").to_string())
+                    .collect();
+                names.dedup();
+                return Err(format!(
+                    "--fix {name}={v}: model `{}` has no fitted parameter `{name}` (fitted parameters: {}; the thickness is --thickness)",
+                    c.model_name(),
+                    names.join(", ")
+                ));
+            }
+        }
+        if let Err(e) = c.build(&base) {
+            return Err(format!("--fix: the model refuses the fixed values: {e}"));
+        }
+        let free: Vec<String> = specs
+            .iter()
+            .zip(&fixed)
+            .filter(|(_, f)| !**f)
+            .map(|(s, _)| s.name.clone())
+            .collect();
+        if free.is_empty() {
+            return Err("--fix holds every parameter: nothing is left to fit".into());
+        }
+        let free_refs: Vec<&str> = free.iter().map(|s| s.as_str()).collect();
+        out.push(Box::new(Subset::new(c, &free_refs, base)?));
+    }
+    Ok(out)
+}

@@ -12,7 +12,9 @@ pub mod dirs;
 pub mod error;
 pub mod models;
 pub mod params;
+pub mod rgl;
 
 pub use atomic::write_atomic;
 pub use error::DataError;
 pub use params::{load_params, Loaded};
+pub use rgl::MeasuredBsdf;

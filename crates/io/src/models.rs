@@ -1,7 +1,8 @@
 //! Models by name, built from a parameter source: the registry that the CLI,
 //! the fitter and the renderer share. Names (DESIGN.md 4.7): `paper`,
 //! `reduced-multilayer` (same parameters as `paper`), `lambert-glass`,
-//! `rough-dielectric`.
+//! `rough-dielectric`; and `measured`, whose "parameters" are a measured
+//! RGL `.bsdf` file ([`crate::rgl`]).
 
 use crate::params::{parse_text, read_source, Loaded};
 use crate::DataError;
@@ -17,10 +18,15 @@ pub enum LoadedModel {
     LambertGlass(Box<LambertGlass>),
     /// `rough-dielectric`.
     RoughDielectric(RoughDielectric),
+    /// `measured`: an RGL `.bsdf` file.
+    Measured(Box<crate::MeasuredBsdf>),
 }
 
 /// Loads model `name` with parameters from `source` (file path or inline JSON).
 pub fn load_model(name: &str, source: &str) -> Result<LoadedModel, DataError> {
+    if name == "measured" {
+        return Ok(LoadedModel::Measured(Box::new(crate::MeasuredBsdf::load(source)?)));
+    }
     let (text, origin, is_toml) = read_source(source)?;
     load_model_text(name, &text, &origin, is_toml)
 }
@@ -61,7 +67,10 @@ pub fn load_model_text(name: &str, text: &str, origin: &str, is_toml: bool) -> R
         _ => {
             return Err(DataError::Other {
                 file: origin.to_string(),
-                message: format!("unknown model `{name}`; known models: {}", MODEL_NAMES.join(", ")),
+                message: format!(
+                    "unknown model `{name}`; known models: {}, measured (an RGL .bsdf file)",
+                    MODEL_NAMES.join(", ")
+                ),
             })
         }
     })
@@ -74,6 +83,7 @@ impl LoadedModel {
             LoadedModel::Paper(m) => m.as_ref(),
             LoadedModel::LambertGlass(m) => m.as_ref(),
             LoadedModel::RoughDielectric(m) => m,
+            LoadedModel::Measured(m) => m.as_ref(),
         }
     }
 
