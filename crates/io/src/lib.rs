@@ -12,7 +12,8 @@ pub mod dirs;
 pub mod error;
 pub mod models;
 pub mod params;
+pub mod text;
 
-pub use atomic::write_atomic;
+pub use atomic::{check_output_path, write_atomic};
 pub use error::DataError;
 pub use params::{load_params, Loaded};
