@@ -57,6 +57,10 @@ pub fn run(args: FitArgs) -> Result<()> {
     if args.samples == 0 || args.starts == 0 || args.max_iter == 0 {
         bail!("--samples, --starts and --max-iter must be at least 1");
     }
+    if let Some(out) = &args.out {
+        // Before the fit, not after it (issue 16).
+        paperbsdf_io::check_output_path(out, "--out")?;
+    }
     let dists = parse_dists(&args.dists)?;
     let ds = load_dataset(&args.data, args.thickness).map_err(|e| anyhow!(e))?;
     let cands = candidates(&args.model, ds.thickness, ds.channels == 3, Some(&dists)).map_err(|e| anyhow!(e))?;

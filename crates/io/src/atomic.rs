@@ -160,7 +160,12 @@ pub fn write_atomic_with<E: std::fmt::Display>(
         .ok_or_else(|| other(path, "not a file name"))?
         .to_string_lossy()
         .into_owned();
-    let tmp = parent_dir(&target).join(format!(".{name}.{}.tmp", std::process::id()));
+    // The temporary name keeps the extension, for writers that choose the format by it.
+    let ext = target
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default();
+    let tmp = parent_dir(&target).join(format!(".{name}.{}.tmp{ext}", std::process::id()));
     register(&tmp, true);
     let result = match write(&tmp) {
         Ok(()) => std::fs::rename(&tmp, &target).map_err(|e| DataError::Io {
@@ -232,7 +237,10 @@ mod tests {
         let link = d.path().join("link.csv");
         std::os::unix::fs::symlink("real.csv", &link).unwrap();
         write_atomic(&link, b"new").unwrap();
-        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink(), "the link stays a link");
+        assert!(
+            std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink(),
+            "the link stays a link"
+        );
         assert_eq!(std::fs::read(&real).unwrap(), b"new");
         // A dangling link creates its target.
         let dangling = d.path().join("dangling.csv");
@@ -244,7 +252,10 @@ mod tests {
         let b = d.path().join("b");
         std::os::unix::fs::symlink(&b, &a).unwrap();
         std::os::unix::fs::symlink(&a, &b).unwrap();
-        assert!(write_atomic(&a, b"x").unwrap_err().to_string().contains("symbolic links"));
+        assert!(write_atomic(&a, b"x")
+            .unwrap_err()
+            .to_string()
+            .contains("symbolic links"));
     }
     #[cfg(unix)]
     #[test]

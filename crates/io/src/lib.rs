@@ -7,6 +7,7 @@
 
 #![warn(missing_docs)]
 
+pub mod angles;
 pub mod atomic;
 pub mod dirs;
 pub mod error;

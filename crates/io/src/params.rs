@@ -76,7 +76,8 @@ fn key_before(text: &str, offset: usize, is_toml: bool) -> Option<String> {
         return prefix.lines().rev().find_map(|l| {
             let (k, _) = l.split_once('=')?;
             let k = k.trim().trim_matches('"');
-            (!k.is_empty() && k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')).then(|| k.to_string())
+            (!k.is_empty() && k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-'))
+                .then(|| k.to_string())
         });
     }
     // JSON: scan strings; a string followed by `:` is a key.
@@ -220,10 +221,16 @@ mod tests {
         assert!(e.contains("parameter `sigma_s`") && e.contains("array of 4"), "{e}");
         let bad = GOOD.replace("\"sigma_a\":0.6", "\"sigma_a\":\"red\"");
         let e = load_params::<PaperParams>(&bad).unwrap_err().to_string();
-        assert!(e.contains("parameter `sigma_a`") && e.contains("a number or an RGB triple"), "{e}");
+        assert!(
+            e.contains("parameter `sigma_a`") && e.contains("a number or an RGB triple"),
+            "{e}"
+        );
         let toml = "d = 0.1\nsigma_a = 0.6\nsigma_s = [1, 2]\ng_f = 0.8\n";
         let e = parse_text::<PaperParams>(toml, "p.toml", true).unwrap_err().to_string();
-        assert!(e.contains("p.toml:3:") && e.contains("sigma_s") && e.contains("RGB triple"), "{e}");
+        assert!(
+            e.contains("p.toml:3:") && e.contains("sigma_s") && e.contains("RGB triple"),
+            "{e}"
+        );
     }
 
     #[test]
