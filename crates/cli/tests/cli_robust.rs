@@ -133,6 +133,34 @@ fn simulate_reports_a_missed_precision_target() {
     );
 }
 
+/// Progress was not shown when standard error is not a terminal: now a line
+/// every 10 s (here every 0.1 s, set by PAPERBSDF_PROGRESS_SECONDS).
+#[test]
+fn simulate_shows_progress_off_a_terminal() {
+    let o = Command::new(env!("CARGO_BIN_EXE_paperbsdf"))
+        .args(strs(&sim(&[
+            "--totals",
+            "--theta-i",
+            "30",
+            "--samples",
+            "400000",
+            "--batches",
+            "8",
+        ])))
+        .env("PAPERBSDF_PROGRESS_SECONDS", "0.1")
+        .current_dir(ROOT)
+        .output()
+        .unwrap();
+    let err = text(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("totals: ") && l.contains(" walks ("))
+        .collect();
+    assert!(!lines.is_empty(), "no progress line: {err}");
+    assert!(lines[0].contains("of 400000 walks"), "{err}");
+}
+
 /// sigma_s = 1e308 (or d = 1e6 with sigma_s = 1e6) ran for minutes without
 /// output (100 walks in 32 s), and its answer was wrong (R + T = 0.64 for a
 /// conservative slab, from rounding of depths): such slabs are refused with the

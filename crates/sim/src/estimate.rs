@@ -16,7 +16,8 @@
 //! refusal before absurd runs), and the achieved precision is reported
 //! ([`BsdfRun::worst_rel_stderr`], [`BsdfRun::target_reached`]). When standard
 //! error is not a terminal, progress is printed as a line every
-//! [`PLAIN_PROGRESS_SECONDS`] seconds instead of a bar.
+//! [`PLAIN_PROGRESS_SECONDS`] seconds instead of a bar (the environment
+//! variable `PAPERBSDF_PROGRESS_SECONDS` sets another interval, e.g. for logs).
 
 use crate::slab::Slab;
 use crate::walk::{Tally, Tracer, MAX_COLLISIONS_PER_WALK};
@@ -411,7 +412,12 @@ fn with_plain_progress<T: Send>(cfg: &SimConfig, pb: &ProgressBar, msg: &str, wo
     std::thread::scope(|s| {
         s.spawn(move || {
             let start = std::time::Instant::now();
-            let every = std::time::Duration::from_secs(PLAIN_PROGRESS_SECONDS);
+            let secs = std::env::var("PAPERBSDF_PROGRESS_SECONDS")
+                .ok()
+                .and_then(|v| v.parse::<f64>().ok())
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .unwrap_or(PLAIN_PROGRESS_SECONDS as f64);
+            let every = std::time::Duration::from_secs_f64(secs.min(1e6));
             while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = rx.recv_timeout(every) {
                 let (pos, len) = (pb.position(), pb.length().unwrap_or(0));
                 eprintln!(
@@ -509,18 +515,22 @@ pub struct Work {
 }
 
 /// Predicted mean number of collisions of a walk in channel medium `m` of a
-/// slab of thickness `d`, mm. Three bounds, the smallest applies: a random
-/// walk started near a face leaves a slab of optical thickness `tau` after
-/// about `tau` collisions (mean exit time of a walk one step from the edge of
-/// a strip `tau` wide); absorption ends it after about `6 / (1 - albedo)`
-/// (weight 0.01 then Russian roulette with survival 0.1); and the per-walk cap
-/// makes the heavy tail of a conservative half-space (`P(N > n) ~ n^-1/2`)
-/// cost about `2 sqrt(MAX_COLLISIONS_PER_WALK)`.
-pub fn collisions_per_walk(m: crate::slab::Medium, d: f64) -> f64 {
+/// slab of thickness `d`, mm, between faces of relative index `eta` (the larger
+/// one). Three bounds, the smallest applies: a random walk started near a face
+/// leaves a slab of optical thickness `tau` after about `tau` collisions (mean
+/// exit time of a walk one step from the edge of a strip `tau` wide), times
+/// the returns from the faces' total internal reflection, `1 / (1 - R_int)`
+/// with `R_int = 1 - 1 / eta^2` for diffuse light inside; absorption ends it
+/// after about `6 / (1 - albedo)` (weight 0.01 then Russian roulette with
+/// survival 0.1); and the per-walk cap makes the heavy tail of a conservative
+/// half-space (`P(N > n) ~ n^-1/2`) cost about `2 sqrt(MAX_COLLISIONS_PER_WALK)`.
+/// An order-of-magnitude model, checked to a factor of 3 in `tests/limits.rs`.
+pub fn collisions_per_walk(m: crate::slab::Medium, d: f64, eta: f64) -> f64 {
     let tau = m.sigma_t * d;
+    let returns = eta.max(1.0).powi(2);
     let absorb = 6.0 / (1.0 - m.albedo).max(f64::MIN_POSITIVE);
     let cap = 2.0 * (MAX_COLLISIONS_PER_WALK as f64).sqrt();
-    1.0 + (m.albedo * tau).min(absorb).min(cap)
+    1.0 + (m.albedo * tau * returns).min(absorb).min(cap)
 }
 
 /// Predicts the collisions a run of `cfg` over `n_dirs` incident directions takes.
@@ -529,7 +539,7 @@ pub fn estimate_work(slab: &Slab, cfg: &SimConfig, n_dirs: usize) -> Work {
     let channels = (0..3).filter(|&c| reps[c] == c).count() as f64;
     let per_walk = (0..3)
         .filter(|&c| reps[c] == c)
-        .map(|c| collisions_per_walk(slab.medium(c), slab.d))
+        .map(|c| collisions_per_walk(slab.medium(c), slab.d, slab.front.eta.max(slab.back.eta)))
         .fold(0.0, f64::max);
     let nb = cfg.batches.max(1) as u64;
     let first = cfg.samples.div_ceil(nb).max(1) * nb;
