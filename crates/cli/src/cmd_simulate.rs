@@ -104,7 +104,7 @@ fn config(a: &SimulateArgs) -> Result<SimConfig> {
             paperbsdf_sim::estimate::MAX_BATCHES
         );
     }
-    if !(a.max_collisions > 0.0) {
+    if a.max_collisions.is_nan() || a.max_collisions <= 0.0 {
         bail!("--max-collisions = {} must be positive", a.max_collisions);
     }
     let samples = match (a.samples, a.rel_stderr) {

@@ -17,7 +17,7 @@ pub struct AngleError(pub String);
 pub fn round_angle(x: f64) -> f64 {
     // Beyond a million degrees the decimals are not representable anyway (and
     // x * 1e9 could overflow): such angles are kept for the range check to refuse.
-    if !(x.abs() < 1e6) {
+    if x.is_nan() || x.abs() >= 1e6 {
         return x;
     }
     let s = 10f64.powi(ANGLE_DECIMALS);
@@ -64,7 +64,7 @@ pub fn parse_angles(s: &str, what: &str, max_count: usize) -> Result<Vec<f64>, A
             }
             // Steps that reach TO (to a part in 1e9 of a step, against rounding).
             let n = ((to - from) / step + 1e-9).floor();
-            if !(n < max_count as f64) {
+            if n.is_nan() || n >= max_count as f64 {
                 return Err(e(format!(
                     "{} angles, more than the limit of {max_count}; use a larger STEP",
                     if n.is_finite() {

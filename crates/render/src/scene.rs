@@ -46,7 +46,7 @@ impl Camera {
         // meaningless roll.
         let up_n = up.normalize_or_zero();
         let sin = forward.cross(up_n).length();
-        if !(sin >= UP_MIN_SIN) {
+        if sin.is_nan() || sin < UP_MIN_SIN {
             return Err(format!(
                 "camera `up` = ({}, {}, {}) is parallel to the viewing direction (the angle between them must be at least {:.4} degrees)",
                 up.x,

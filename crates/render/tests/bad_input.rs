@@ -299,7 +299,7 @@ fn camera_up_parallel_within_tolerance() {
     let dir = tempfile::tempdir().unwrap();
     let mut slipped_through_before = false;
     for k in [1.0, 0.1, 0.3, 7.0, -0.7, 1e-3] {
-        let (y, z) = (3.0 * k, -1.0 * k);
+        let (y, z) = (3.0 * k, -k);
         // The old check: the cross product of the normalised view direction and `up` exactly zero.
         let f = glam::DVec3::new(0.0, 3.0, -1.0).normalize();
         slipped_through_before |= f.cross(glam::DVec3::new(0.0, y, z)) != glam::DVec3::ZERO;

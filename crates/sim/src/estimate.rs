@@ -233,7 +233,7 @@ pub const MAX_OPTICAL_THICKNESS: f64 = 1e9;
 pub fn check_slab(slab: &Slab) -> Result<(), SimError> {
     for c in 0..3 {
         let tau = slab.medium(c).sigma_t * slab.d;
-        if !(tau <= MAX_OPTICAL_THICKNESS) {
+        if tau.is_nan() || tau > MAX_OPTICAL_THICKNESS {
             return Err(SimError::BadConfig {
                 name: "sigma_t * d",
                 value: tau,
