@@ -8,9 +8,10 @@
 //!   the link stays (links are followed to their final target);
 //! - an existing target that is not a regular file (a directory, FIFO, socket
 //!   or device node) is refused, never replaced;
-//! - every temporary file in progress is registered, and
-//!   [`remove_temp_files`] (called by the Ctrl-C handlers) deletes them, so no
-//!   temporary file survives an interruption.
+//! - an interruption never leaves a temporary file: the Ctrl-C handlers call
+//!   [`remove_temp_files`], which waits for the writes in progress to finish
+//!   (each is a complete file renamed into place), stops new ones from
+//!   starting, and deletes any registered temporary file left.
 
 use crate::DataError;
 use std::io::Write;
@@ -19,6 +20,9 @@ use std::sync::Mutex;
 
 /// Temporary files being written right now (removed by [`remove_temp_files`]).
 static IN_PROGRESS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Held shared by every write, taken exclusively (and kept) by [`remove_temp_files`].
+static WRITING: std::sync::RwLock<()> = std::sync::RwLock::new(());
 
 /// Symbolic links followed at most (as the kernel's limit, ELOOP beyond).
 const MAX_LINKS: usize = 40;
@@ -119,9 +123,18 @@ pub fn check_output_path(path: impl AsRef<Path>, what: &str) -> Result<PathBuf, 
     Ok(target)
 }
 
-/// Deletes every temporary file an atomic write is still writing. For signal
-/// handlers: call it, then exit; later writes in this process are not affected.
+/// For signal handlers, just before the process exits: waits until the atomic
+/// writes in progress have finished, blocks every later write for the rest of
+/// the process's life, and deletes any temporary file still registered.
 pub fn remove_temp_files() {
+    let guard = WRITING.write().unwrap_or_else(|p| p.into_inner());
+    // Never released: no write may start between this and the exit.
+    std::mem::forget(guard);
+    remove_registered();
+}
+
+/// Deletes every registered temporary file.
+fn remove_registered() {
     // A poisoned lock still holds the list.
     let list = match IN_PROGRESS.lock() {
         Ok(g) => g.clone(),
@@ -166,6 +179,7 @@ pub fn write_atomic_with<E: std::fmt::Display>(
         .map(|e| format!(".{}", e.to_string_lossy()))
         .unwrap_or_default();
     let tmp = parent_dir(&target).join(format!(".{name}.{}.tmp{ext}", std::process::id()));
+    let _writing = WRITING.read().unwrap_or_else(|p| p.into_inner());
     register(&tmp, true);
     let result = match write(&tmp) {
         Ok(()) => std::fs::rename(&tmp, &target).map_err(|e| DataError::Io {
@@ -310,8 +324,8 @@ mod tests {
         let p = d.path().join("slow.bin");
         write_atomic_with(&p, |tmp| -> std::io::Result<()> {
             std::fs::write(tmp, b"partial")?;
-            // What a signal handler does in the middle of a write.
-            remove_temp_files();
+            // What a signal handler does when a write is cut short.
+            remove_registered();
             assert!(!tmp.exists(), "the handler removed the temporary file");
             Ok(())
         })
