@@ -98,16 +98,16 @@ pub fn check_output_path(path: impl AsRef<Path>, what: &str) -> Result<PathBuf, 
         format!("{what} {} (a link to {})", path.display(), target.display())
     };
     if target.file_name().is_none() || path.as_os_str().to_string_lossy().ends_with('/') {
-        return Err(other(path, format!("{shown}: not a file name")));
+        return Err(other(Path::new(&shown), "not a file name"));
     }
     let dir = parent_dir(&target);
     match std::fs::metadata(&dir) {
         Ok(m) if m.is_dir() => {}
-        Ok(_) => return Err(other(path, format!("{shown}: `{}` is not a directory", dir.display()))),
+        Ok(_) => return Err(other(Path::new(&shown), format!("`{}` is not a directory", dir.display()))),
         Err(_) => {
             return Err(other(
-                path,
-                format!("{shown}: the directory `{}` does not exist", dir.display()),
+                Path::new(&shown),
+                format!("the directory `{}` does not exist", dir.display()),
             ))
         }
     }
@@ -115,8 +115,8 @@ pub fn check_output_path(path: impl AsRef<Path>, what: &str) -> Result<PathBuf, 
         let ft = m.file_type();
         if !ft.is_file() {
             return Err(other(
-                path,
-                format!("{shown}: the target is {}; refusing to replace it", describe(&ft)),
+                Path::new(&shown),
+                format!("the target is {}; refusing to replace it", describe(&ft)),
             ));
         }
     }
