@@ -103,7 +103,12 @@ pub fn check_output_path(path: impl AsRef<Path>, what: &str) -> Result<PathBuf, 
     let dir = parent_dir(&target);
     match std::fs::metadata(&dir) {
         Ok(m) if m.is_dir() => {}
-        Ok(_) => return Err(other(Path::new(&shown), format!("`{}` is not a directory", dir.display()))),
+        Ok(_) => {
+            return Err(other(
+                Path::new(&shown),
+                format!("`{}` is not a directory", dir.display()),
+            ))
+        }
         Err(_) => {
             return Err(other(
                 Path::new(&shown),
