@@ -2,7 +2,7 @@
 //! and writes the measurement CSV that `fit` and `plot` read
 //! (`kind,theta_i_deg,theta_o_deg,r,g,b`, reflection only; DESIGN.md section 2).
 
-use crate::cmd_eval::{check_angles, parse_range};
+use crate::cmd_eval::{check_angles, MAX_EVAL_ANGLES};
 use anyhow::{anyhow, bail, Result};
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::Bsdf;
@@ -32,7 +32,7 @@ pub struct ConvertArgs {
 
 /// Runs `paperbsdf convert`.
 pub fn run(a: ConvertArgs) -> Result<()> {
-    let to = parse_range(&a.theta_o, "--theta-o")?;
+    let to = paperbsdf_io::angles::parse_angles(&a.theta_o, "--theta-o", MAX_EVAL_ANGLES)?;
     check_angles(&a.theta_i, "--theta-i", 0.0, 89.999)?;
     check_angles(&to, "--theta-o", -89.999, 89.999)?;
     let filter = PointFilter {

@@ -1,7 +1,7 @@
 //! `paperbsdf eval` and `paperbsdf albedo`: a model's BSDF values and directional
 //! albedo, in the conventions of DESIGN.md section 2.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::{DVec3, Rgb};
 use paperbsdf_io::models::{load_model, LoadedModel};
@@ -21,7 +21,7 @@ pub struct EvalArgs {
     /// In-plane incident angles in degrees, comma-separated (e.g. `0,30,60`).
     #[arg(long = "theta-i", value_delimiter = ',', allow_hyphen_values = true)]
     pub theta_i: Vec<f64>,
-    /// In-plane viewing angles FROM:TO:STEP in degrees (signed; negative is opposite the light).
+    /// In-plane viewing angles: one angle, or FROM:TO:STEP, in degrees (signed; negative is opposite the light).
     #[arg(long = "theta-o", allow_hyphen_values = true)]
     pub theta_o: Option<String>,
     /// Which component to evaluate: surface, single, multiple, direct or all.
@@ -52,30 +52,9 @@ pub struct AlbedoArgs {
     pub side: String,
 }
 
-/// Parses `FROM:TO:STEP` (degrees) into the list of angles, TO included when hit.
-pub fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
-    let parts: Vec<&str> = s.split(':').collect();
-    if parts.len() != 3 {
-        bail!("{what} `{s}`: expected FROM:TO:STEP in degrees, e.g. -80:80:10");
-    }
-    let num = |p: &str| {
-        p.trim()
-            .parse::<f64>()
-            .with_context(|| format!("{what} `{s}`: `{p}` is not a number"))
-    };
-    let (from, to, step) = (num(parts[0])?, num(parts[1])?, num(parts[2])?);
-    if step.is_nan() || step <= 0.0 || !from.is_finite() || !to.is_finite() {
-        bail!("{what} `{s}`: STEP must be positive and FROM, TO finite");
-    }
-    let n = ((to - from) / step + 1e-9).floor();
-    if n < 0.0 {
-        bail!("{what} `{s}`: TO is below FROM");
-    }
-    if n > 100_000.0 {
-        bail!("{what} `{s}`: more than 100000 angles");
-    }
-    Ok((0..=n as usize).map(|k| from + k as f64 * step).collect())
-}
+/// Most angles `eval` accepts in `--theta-o` (evaluating is cheap; the limit
+/// bounds the output, 2 rows per angle and incident angle).
+pub const MAX_EVAL_ANGLES: usize = 100_000;
 
 /// Checks in-plane angles are within [lo, hi] degrees.
 pub fn check_angles(v: &[f64], what: &str, lo: f64, hi: f64) -> Result<()> {
@@ -124,6 +103,9 @@ fn emit(out: &Option<String>, text: String) -> Result<()> {
 
 /// Runs `paperbsdf eval`.
 pub fn run_eval(a: EvalArgs) -> Result<()> {
+    if let Some(out) = &a.out {
+        paperbsdf_io::check_output_path(out, "--out")?;
+    }
     let model = load_model(&a.model, &a.params)?;
     let component = a.component.as_str();
     let eval =
@@ -141,7 +123,7 @@ pub fn run_eval(a: EvalArgs) -> Result<()> {
         }
     } else {
         let to = match &a.theta_o {
-            Some(s) => parse_range(s, "--theta-o")?,
+            Some(s) => paperbsdf_io::angles::parse_angles(s, "--theta-o", MAX_EVAL_ANGLES)?,
             None => bail!("give either --dirs F.csv or --theta-i LIST with --theta-o FROM:TO:STEP"),
         };
         if a.theta_i.is_empty() {
@@ -171,7 +153,12 @@ pub fn run_albedo(a: AlbedoArgs) -> Result<()> {
         "back" => -1.0,
         s => bail!("--side `{s}`: expected `front` (light from z > 0) or `back` (light from z < 0)"),
     };
-    check_angles(&a.theta_i, "--theta-i", 0.0, 90.0)?;
+    // [0, 90), as the help says: at 90 degrees the light grazes the sheet and no flux enters.
+    for &t in &a.theta_i {
+        if !(t.is_finite() && (0.0..90.0).contains(&t)) {
+            bail!("--theta-i = {t} is outside the allowed range [0, 90) degrees");
+        }
+    }
     let rgb = model.is_rgb();
     let mut text = if rgb {
         "theta_i_deg,reflectance_r,reflectance_g,reflectance_b,transmittance_r,transmittance_g,transmittance_b\n"

@@ -87,6 +87,10 @@ pub fn run(args: FitArgs) -> Result<()> {
     if args.samples == 0 || args.starts == 0 || args.max_iter == 0 {
         bail!("--samples, --starts and --max-iter must be at least 1");
     }
+    if let Some(out) = &args.out {
+        // Before the fit, not after it (issue 16).
+        paperbsdf_io::check_output_path(out, "--out")?;
+    }
     let dists = parse_dists(&args.dists)?;
     let filter = PointFilter {
         exclude_retro_deg: args.exclude_retro,

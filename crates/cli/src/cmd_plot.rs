@@ -75,6 +75,7 @@ pub fn run(args: PlotArgs) -> Result<()> {
         .out
         .clone()
         .ok_or_else(|| anyhow!("--out FILE.png or FILE.svg is required"))?;
+    paperbsdf_io::check_output_path(&out, "--out")?;
     if !(args.fit.is_empty() || args.fit.len() == 1 || args.fit.len() == args.data.len()) {
         bail!(
             "give one --fit for all data files or one per data file ({} data files, {} fits)",

@@ -1,7 +1,10 @@
 //! `paperbsdf render`: renders a TOML scene file or a built-in scene with the
 //! path tracer of `paperbsdf-render`, writing `FILE.exr` (linear radiance) and
 //! `FILE.png` (tone-mapped sRGB), each atomically. Ctrl-C stops the render
-//! and still writes the image accumulated so far.
+//! and still writes the image accumulated so far, then exits with code 130.
+//! The output stem is kept as given (`--out run.v2` writes `run.v2.exr` and
+//! `run.v2.png`; a final `.exr` or `.png` is dropped); both paths are checked
+//! before the render starts, as is the memory the image needs.
 
 use paperbsdf_render::{builtin, film, RenderOptions};
 use std::path::{Path, PathBuf};
@@ -14,7 +17,7 @@ pub struct RenderArgs {
     /// Samples per pixel (default: the scene's `render.spp`).
     #[arg(long)]
     pub spp: Option<u32>,
-    /// Output file stem: writes STEM.exr and STEM.png (default: the scene's name in the current directory).
+    /// Output file stem: writes STEM.exr and STEM.png, the stem kept as given (a final .exr or .png is dropped; default: the scene's name in the current directory).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Random seed (default: the scene's `render.seed`).
@@ -81,6 +84,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
                 .unwrap_or_else(|| "render".into()),
         ),
     };
+    let exr = with_suffix(&stem, "exr");
+    let png = with_suffix(&stem, "png");
+    paperbsdf_io::check_output_path(&exr, "--out")?;
+    paperbsdf_io::check_output_path(&png, "--out")?;
+    let (w, h) = (scene.settings.width, scene.settings.height);
+    paperbsdf_render::check_memory(w, h, paperbsdf_render::available_memory_bytes()).map_err(anyhow::Error::msg)?;
     let cancel = paperbsdf_render::install_ctrlc_flag().map_err(anyhow::Error::msg)?;
     let spp = scene.settings.spp;
     let opts = RenderOptions {
@@ -90,14 +99,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     };
     let (out, nthreads) =
         paperbsdf_render::render_with_threads(&scene, &opts, cancel, args.threads).map_err(anyhow::Error::msg)?;
-    let (w, h) = (scene.settings.width, scene.settings.height);
     let img = out.film.image();
-    let exr = stem.with_extension("exr");
-    let png = stem.with_extension("png");
     film::write_exr(&exr, w, h, &img).map_err(anyhow::Error::msg)?;
     film::write_png(&png, w, h, &img, scene.settings.exposure).map_err(anyhow::Error::msg)?;
     let mean = img.iter().fold(paperbsdf_core::Rgb::ZERO, |a, &b| a + b) / img.len() as f64;
-    eprintln!(
+    let summary = format!(
         "{}{}x{} at {} spp in {:.2} s ({:.3} M samples/s, {} threads); mean radiance ({:.4}, {:.4}, {:.4}); wrote {} and {}",
         if out.cancelled { "INTERRUPTED: " } else { "" },
         w,
@@ -112,5 +118,32 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         exr.display(),
         png.display()
     );
+    if out.cancelled {
+        return Err(crate::Interrupted(summary).into());
+    }
+    eprintln!("{summary}");
     Ok(())
+}
+
+/// `stem` with `.ext` appended to its file name (not replacing an extension:
+/// `run.v2` gives `run.v2.exr`).
+fn with_suffix(stem: &Path, ext: &str) -> PathBuf {
+    let mut s = stem.as_os_str().to_os_string();
+    s.push(".");
+    s.push(ext);
+    PathBuf::from(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn stem_is_kept_as_given() {
+        // Issue 16: `--out run.v2` wrote run.exr, replacing what `--out run.v3` wrote.
+        assert_eq!(
+            with_suffix(Path::new("out/run.v2"), "exr"),
+            PathBuf::from("out/run.v2.exr")
+        );
+        assert_eq!(with_suffix(Path::new("run"), "png"), PathBuf::from("run.png"));
+    }
 }

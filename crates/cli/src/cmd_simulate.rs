@@ -33,12 +33,16 @@ pub struct SimulateArgs {
     /// Keep simulating until every positive estimate has a standard error below this fraction of its value.
     #[arg(long = "rel-stderr")]
     pub rel_stderr: Option<f64>,
-    /// Upper limit of walks per incident angle with --rel-stderr.
+    /// Upper limit of walks per incident angle with --rel-stderr (at least 1).
     #[arg(long = "max-samples", default_value_t = 1 << 26)]
     pub max_samples: u64,
-    /// Independent batches the walks are split into (standard errors come from their spread).
+    /// Independent batches the walks are split into (standard errors come from their spread), 2 to 100000.
     #[arg(long, default_value_t = 32)]
     pub batches: u32,
+    /// Refuse runs predicted to take more collisions than this (the prediction
+    /// and the time it means are printed); raise it to run anyway.
+    #[arg(long = "max-collisions", default_value_t = DEFAULT_MAX_COLLISIONS)]
+    pub max_collisions: f64,
     /// Seed; the output is reproducible for a given seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -51,6 +55,14 @@ pub struct SimulateArgs {
 const DEFAULT_SAMPLES: u64 = 1 << 16;
 /// First round of walks with --rel-stderr.
 const ADAPTIVE_FIRST_ROUND: u64 = 1 << 13;
+/// Default of `--max-collisions`: 2e10 collisions, about 10 to 30 minutes on
+/// two cores (the collision rate with one viewing direction is 1e7 to 3e7 per
+/// second there); paper at the default 65536 walks takes about 1e8.
+pub const DEFAULT_MAX_COLLISIONS: f64 = 2e10;
+/// Most viewing angles in one run: every angle adds two next-event
+/// estimates (R and T) to every collision of every walk, so the run's time
+/// grows with their number (eval, which costs nothing per angle, allows 100000).
+pub const MAX_VIEW_ANGLES: usize = 1000;
 
 /// Loads and validates the parameters; errors name the file, line and parameter.
 fn load(source: &str) -> Result<PaperParams> {
@@ -82,11 +94,18 @@ fn config(a: &SimulateArgs) -> Result<SimConfig> {
     if a.samples == Some(0) {
         bail!("--samples = 0: need at least one walk");
     }
-    if a.batches < 2 {
+    if a.max_samples == 0 {
+        bail!("--max-samples = 0: need at least one walk");
+    }
+    if !(2..=paperbsdf_sim::estimate::MAX_BATCHES).contains(&a.batches) {
         bail!(
-            "--batches = {}: need at least 2 batches for a standard error",
-            a.batches
+            "--batches = {} is outside the allowed range [2, {}] (at least 2 for a standard error)",
+            a.batches,
+            paperbsdf_sim::estimate::MAX_BATCHES
         );
+    }
+    if a.max_collisions.is_nan() || a.max_collisions <= 0.0 {
+        bail!("--max-collisions = {} must be positive", a.max_collisions);
     }
     let samples = match (a.samples, a.rel_stderr) {
         (Some(n), _) => n,
@@ -102,6 +121,100 @@ fn config(a: &SimulateArgs) -> Result<SimConfig> {
         progress: true,
         by_order: false,
     })
+}
+
+/// Refuses a run predicted to take more than `--max-collisions` collisions,
+/// with the reason and the estimated time (from a short pilot of walks).
+fn check_work(
+    a: &SimConfigArgs,
+    slab: &Slab,
+    cfg: &SimConfig,
+    wi: paperbsdf_core::DVec3,
+    wos: &[paperbsdf_core::DVec3],
+    n_dirs: usize,
+) -> Result<()> {
+    let w = paperbsdf_sim::estimate::estimate_work(slab, cfg, n_dirs);
+    if w.collisions <= a.max_collisions {
+        return Ok(());
+    }
+    let rate = paperbsdf_sim::estimate::measure_collision_rate(slab, wi, wos, 0.3);
+    let m = (0..3).map(|c| slab.medium(c)).fold(slab.medium(0), |x, y| {
+        if y.sigma_t * slab.d > x.sigma_t * slab.d {
+            y
+        } else {
+            x
+        }
+    });
+    bail!(
+        "this run would take about {:.1e} collisions ({:.0e} walks of about {:.0} collisions each), \
+about {} at the measured {:.1e} collisions/s, more than --max-collisions = {:.1e}: the slab is \
+{:.3e} mean free paths thick (sigma_t * d) with single-scattering albedo {:.6}; \
+lower --samples or raise --max-collisions to run anyway",
+        w.collisions,
+        w.walks,
+        w.collisions_per_walk,
+        human_time(w.collisions / rate),
+        rate,
+        a.max_collisions,
+        m.sigma_t * slab.d,
+        m.albedo
+    )
+}
+
+/// `3.2 s`, `4.5 min`, `2.1 h`, `3.0 days`.
+fn human_time(s: f64) -> String {
+    if s < 120.0 {
+        format!("{s:.1} s")
+    } else if s < 7200.0 {
+        format!("{:.1} min", s / 60.0)
+    } else if s < 172_800.0 {
+        format!("{:.1} h", s / 3600.0)
+    } else {
+        format!("{:.1e} days", s / 86400.0)
+    }
+}
+
+/// What the options of a run allow beyond the [`SimConfig`].
+struct SimConfigArgs {
+    max_collisions: f64,
+}
+
+/// Notes on a run for the end of the output: achieved precision, walks cut.
+fn run_notes(
+    what: &str,
+    cfg: &SimConfig,
+    samples: u64,
+    truncated: u64,
+    worst: f64,
+    reached: bool,
+    notes: &mut Vec<String>,
+) {
+    if let Some(x) = cfg.rel_stderr {
+        let status = if reached {
+            "reached".to_string()
+        } else {
+            format!("NOT reached: stopped by --max-samples {}", cfg.max_samples)
+        };
+        notes.push(format!(
+            "{what}: {samples} walks, worst relative standard error {worst:.3e} (target {x:e} {status})"
+        ));
+        if !reached {
+            eprintln!(
+                "warning: {what}: --rel-stderr {x:e} not reached after {samples} walks (--max-samples); \
+the worst relative standard error is {worst:.3e}"
+            );
+        }
+    }
+    if truncated > 0 {
+        let m = format!(
+            "WARNING {what}: {truncated} walks were cut at {} collisions; their remaining flux \
+(at most {:.3e} of the incident flux) is missing from these estimates",
+            paperbsdf_sim::walk::MAX_COLLISIONS_PER_WALK,
+            truncated as f64 / samples.max(1) as f64
+        );
+        eprintln!("warning: {}", m.trim_start_matches("WARNING "));
+        notes.push(m);
+    }
 }
 
 fn fmt(v: f64) -> String {
@@ -137,11 +250,19 @@ fn header_line(p: &PaperParams, cfg: &SimConfig) -> String {
 
 /// Runs `paperbsdf simulate`.
 pub fn run(a: SimulateArgs) -> Result<()> {
+    if let Some(out) = &a.out {
+        paperbsdf_io::check_output_path(out, "--out")?;
+    }
     let p = load(&a.params)?;
     let slab = Slab::from_params(&p).with_context(|| format!("parameters `{}`", a.params))?;
+    paperbsdf_sim::estimate::check_slab(&slab).with_context(|| format!("parameters `{}`", a.params))?;
     let cfg = config(&a)?;
+    let limits = SimConfigArgs {
+        max_collisions: a.max_collisions,
+    };
     let rgb = slab.rgb;
     let mut text = header_line(&p, &cfg);
+    let mut notes = Vec::new();
     if a.totals {
         let cols = if rgb {
             "R_r,R_g,R_b,R_r_stderr,R_g_stderr,R_b_stderr,T_r,T_g,T_b,T_r_stderr,T_g_stderr,T_b_stderr"
@@ -150,7 +271,17 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         };
         if a.diffuse {
             text.push_str(&format!("incidence,{cols}\n"));
+            check_work(&limits, &slab, &cfg, paperbsdf_core::DVec3::Z, &[], 1)?;
             let t = simulate_totals(&slab, Incidence::Diffuse { front: true }, &cfg)?;
+            run_notes(
+                "diffuse",
+                &cfg,
+                t.samples,
+                t.truncated,
+                t.worst_rel_stderr,
+                t.target_reached,
+                &mut notes,
+            );
             text.push_str(&format!(
                 "diffuse,{},{}\n",
                 fmt_estimate(&t.reflectance, rgb),
@@ -162,9 +293,20 @@ pub fn run(a: SimulateArgs) -> Result<()> {
             }
             check_angles(&a.theta_i, "--theta-i", 0.0, true, 90.0)?;
             text.push_str(&format!("theta_i_deg,{cols}\n"));
+            let (wi0, _) = in_plane_directions(a.theta_i[0], 0.0, false);
+            check_work(&limits, &slab, &cfg, wi0, &[], a.theta_i.len())?;
             for &ti in &a.theta_i {
                 let (wi, _) = in_plane_directions(ti, 0.0, false);
                 let t = simulate_totals(&slab, Incidence::Collimated(wi), &cfg)?;
+                run_notes(
+                    &format!("theta_i {ti}"),
+                    &cfg,
+                    t.samples,
+                    t.truncated,
+                    t.worst_rel_stderr,
+                    t.target_reached,
+                    &mut notes,
+                );
                 text.push_str(&format!(
                     "{ti},{},{}\n",
                     fmt_estimate(&t.reflectance, rgb),
@@ -179,9 +321,24 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         if a.theta_i.is_empty() {
             bail!("--theta-o needs --theta-i LIST (degrees)");
         }
-        let to = crate::cmd_eval::parse_range(range, "--theta-o")?;
+        let to = paperbsdf_io::angles::parse_angles(range, "--theta-o", MAX_VIEW_ANGLES)?;
         check_angles(&a.theta_i, "--theta-i", 0.0, true, 90.0)?;
         check_angles(&to, "--theta-o", -90.0, false, 90.0)?;
+        {
+            let ti = a.theta_i[0];
+            let wos: Vec<_> = [false, true]
+                .iter()
+                .flat_map(|&t| to.iter().map(move |&o| in_plane_directions(ti, o, t).1))
+                .collect();
+            check_work(
+                &limits,
+                &slab,
+                &cfg,
+                in_plane_directions(ti, 0.0, false).0,
+                &wos,
+                a.theta_i.len(),
+            )?;
+        }
         let cols = if rgb {
             "r,g,b,r_stderr,g_stderr,b_stderr"
         } else {
@@ -198,6 +355,15 @@ pub fn run(a: SimulateArgs) -> Result<()> {
             }
             let (wi, _) = in_plane_directions(ti, 0.0, false);
             let run = simulate_bsdf(&slab, wi, &wos, &cfg)?;
+            run_notes(
+                &format!("theta_i {ti}"),
+                &cfg,
+                run.samples,
+                run.truncated,
+                run.worst_rel_stderr,
+                run.target_reached,
+                &mut notes,
+            );
             for (k, (kind, _)) in [("R", false), ("T", true)].iter().enumerate() {
                 for (j, &o) in to.iter().enumerate() {
                     text.push_str(&format!(
@@ -207,6 +373,9 @@ pub fn run(a: SimulateArgs) -> Result<()> {
                 }
             }
         }
+    }
+    for n in &notes {
+        text.push_str(&format!("# {n}\n"));
     }
     match &a.out {
         Some(path) => paperbsdf_io::write_atomic(path, text.as_bytes())?,
@@ -231,6 +400,7 @@ mod tests {
             max_samples: 1 << 20,
             batches: 8,
             seed: 3,
+            max_collisions: DEFAULT_MAX_COLLISIONS,
             out: None,
         }
     }

@@ -2,7 +2,9 @@
 //!
 //! Each subcommand lives in its own module (`cmd_*.rs`); this file only parses
 //! arguments and reports errors. Errors are printed as `error: ...` with their
-//! chain of causes and exit code 2; nothing panics on bad input.
+//! chain of causes (a cause whose text the message already shows is not
+//! repeated) and exit code 2; nothing panics on bad input. An interrupted run
+//! (Ctrl-C) exits with 130 and leaves no temporary file behind.
 
 use clap::{Parser, Subcommand};
 
@@ -39,8 +41,46 @@ enum Command {
     Render(cmd_render::RenderArgs),
 }
 
+/// The error of a run stopped by Ctrl-C after writing what it had (exit code 130).
+#[derive(Debug)]
+pub struct Interrupted(pub String);
+
+impl std::fmt::Display for Interrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for Interrupted {}
+
+/// Exit code of a run stopped by SIGINT (128 + 2, as shells report it).
+pub const EXIT_INTERRUPTED: i32 = 130;
+
+/// The lines printed for an error: the message, then each cause not already shown.
+fn error_lines(e: &anyhow::Error) -> Vec<String> {
+    let mut lines = vec![format!("error: {e}")];
+    let mut shown = e.to_string();
+    for cause in e.chain().skip(1) {
+        let c = cause.to_string();
+        if shown.contains(&c) {
+            continue;
+        }
+        lines.push(format!("  caused by: {c}"));
+        shown.push_str(&c);
+    }
+    lines
+}
+
 fn main() {
     let cli = Cli::parse();
+    if !matches!(cli.command, Command::Render(_)) {
+        // Render has its own handler (first Ctrl-C: stop and write the partial image).
+        let _ = ctrlc::set_handler(|| {
+            paperbsdf_io::atomic::remove_temp_files();
+            eprintln!("\ninterrupted");
+            std::process::exit(EXIT_INTERRUPTED);
+        });
+    }
     let result = match cli.command {
         Command::Eval(a) => cmd_eval::run_eval(a),
         Command::Albedo(a) => cmd_eval::run_albedo(a),
@@ -51,10 +91,35 @@ fn main() {
         Command::Render(a) => cmd_render::run(a),
     };
     if let Err(e) = result {
-        eprintln!("error: {e}");
-        for cause in e.chain().skip(1) {
-            eprintln!("  caused by: {cause}");
+        if let Some(i) = e.downcast_ref::<Interrupted>() {
+            eprintln!("{i}");
+            std::process::exit(EXIT_INTERRUPTED);
+        }
+        for l in error_lines(&e) {
+            eprintln!("{l}");
         }
         std::process::exit(2);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn causes_already_in_the_message_are_not_repeated() {
+        // Issue 16: `x.json: No such file` was followed by `caused by: No such file`.
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "No such file or directory (os error 2)");
+        let e: anyhow::Error = paperbsdf_io::DataError::Io {
+            file: "x.json".into(),
+            source: io,
+        }
+        .into();
+        assert_eq!(
+            error_lines(&e),
+            ["error: x.json: No such file or directory (os error 2)"]
+        );
+        // A cause with new information is still shown.
+        let e = anyhow::anyhow!("disk full").context("writing out.csv");
+        assert_eq!(error_lines(&e), ["error: writing out.csv", "  caused by: disk full"]);
     }
 }

@@ -46,7 +46,7 @@ fn scene_file_errors_name_file_and_entry() {
 }
 
 /// SIGINT (what Ctrl-C sends) stops the render; the partial image is written
-/// and the command succeeds, saying it was interrupted.
+/// and the command exits with 130 (issue 16: it exited 0), saying it was interrupted.
 #[cfg(unix)]
 #[test]
 fn sigint_writes_the_partial_image() {
@@ -77,8 +77,13 @@ fn sigint_writes_the_partial_image() {
     };
     let mut err = String::new();
     std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut err).unwrap();
-    assert!(status.success(), "exit status {status}: {err}");
+    assert_eq!(status.code(), Some(130), "exit status {status}: {err}");
     assert!(err.contains("INTERRUPTED"), "{err}");
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 2, "only the two images, no temporary file: {left:?}");
     let exr = stem.with_extension("exr");
     assert!(exr.exists() && stem.with_extension("png").exists(), "{err}");
     let (w, h, img) = paperbsdf_render::film::read_exr(&exr).unwrap();

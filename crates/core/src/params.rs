@@ -91,14 +91,55 @@ impl ParamError {
 use crate::microfacet::Distribution;
 
 /// A parameter that may vary with wavelength: a number or an RGB triple
-/// (DESIGN.md section 2). Serialises as a number or a 3-array.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+/// (DESIGN.md section 2). Serialises as a number or a 3-array; anything else
+/// (an array of another length, a string) is an error saying which forms are
+/// accepted.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 #[serde(untagged)]
 pub enum Colour {
     /// The same value in every channel.
     Scalar(f64),
     /// Red, green, blue.
     Rgb([f64; 3]),
+}
+
+impl<'de> serde::Deserialize<'de> for Colour {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        const EXPECTED: &str = "a number or an RGB triple [r, g, b] of exactly 3 numbers";
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = Colour;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(EXPECTED)
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Colour, E> {
+                Ok(Colour::Scalar(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Colour, E> {
+                Ok(Colour::Scalar(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Colour, E> {
+                Ok(Colour::Scalar(v as f64))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Colour, A::Error> {
+                let mut c = [0.0; 3];
+                let mut n = 0usize;
+                while let Some(v) = seq.next_element::<f64>()? {
+                    if n < 3 {
+                        c[n] = v;
+                    }
+                    n += 1;
+                }
+                if n != 3 {
+                    return Err(serde::de::Error::custom(format!(
+                        "an array of {n} numbers; expected {EXPECTED}"
+                    )));
+                }
+                Ok(Colour::Rgb(c))
+            }
+        }
+        d.deserialize_any(V)
+    }
 }
 
 impl Colour {

@@ -164,6 +164,8 @@ pub fn parse_measurement(text: &str, origin: &str) -> Result<Measurement, Measur
         width: usize,
     }
     let mut layout: Option<Layout> = None;
+    // A UTF-8 byte-order mark is not content (issue 16: it made the first comment line the header).
+    let text = paperbsdf_io::text::strip_bom(text);
     for (ln0, raw) in text.lines().enumerate() {
         let ln = ln0 + 1;
         let line = raw.trim();

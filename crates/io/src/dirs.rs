@@ -35,10 +35,7 @@ const COLS: [&str; 6] = ["wi_x", "wi_y", "wi_z", "wo_x", "wo_y", "wo_z"];
 
 /// Reads a direction file from `path`.
 pub fn read_dirs(path: &str) -> Result<DirFile, DataError> {
-    let text = std::fs::read_to_string(path).map_err(|e| DataError::Io {
-        file: path.to_string(),
-        source: e,
-    })?;
+    let text = crate::text::read_text(path)?;
     parse_dirs(&text, path)
 }
 
@@ -50,7 +47,7 @@ pub fn parse_dirs(text: &str, origin: &str) -> Result<DirFile, DataError> {
         field: field.to_string(),
         message,
     };
-    let mut lines = text
+    let mut lines = crate::text::strip_bom(text)
         .lines()
         .enumerate()
         .map(|(i, l)| (i + 1, l.trim()))
@@ -142,5 +139,15 @@ mod tests {
         let e = parse_dirs("a,b\n1,2\n", "y.csv").unwrap_err().to_string();
         assert!(e.contains("missing column `wi_x`"), "{e}");
         assert!(parse_dirs("", "z.csv").is_err());
+    }
+    #[test]
+    fn byte_order_mark_is_ignored() {
+        // Issue 16: a UTF-8 BOM before the header gave `missing column wi_x`.
+        let t = "\u{feff}wi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n0,0,1,1,0,0\n";
+        let f = parse_dirs(t, "bom.csv").unwrap();
+        assert_eq!(f.header[0], "wi_x");
+        assert_eq!(f.rows.len(), 1);
+        let t = "\u{feff}# comment first\nwi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n0,0,1,1,0,0\n";
+        assert_eq!(parse_dirs(t, "bom.csv").unwrap().rows[0].line, 3);
     }
 }

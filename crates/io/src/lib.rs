@@ -7,14 +7,16 @@
 
 #![warn(missing_docs)]
 
+pub mod angles;
 pub mod atomic;
 pub mod dirs;
 pub mod error;
 pub mod models;
 pub mod params;
 pub mod rgl;
+pub mod text;
 
-pub use atomic::write_atomic;
+pub use atomic::{check_output_path, write_atomic};
 pub use error::DataError;
 pub use params::{load_params, Loaded};
 pub use rgl::MeasuredBsdf;

@@ -58,40 +58,107 @@ pub fn read_source(source: &str) -> Result<(String, String, bool), DataError> {
     if s.starts_with('{') {
         return Ok((source.to_string(), "<inline>".to_string(), false));
     }
-    let text = std::fs::read_to_string(source).map_err(|e| DataError::Io {
-        file: source.to_string(),
-        source: e,
-    })?;
+    let text = crate::text::read_text(source)?;
     let is_toml = source.to_ascii_lowercase().ends_with(".toml");
     Ok((text, source.to_string(), is_toml))
 }
 
-/// Parses `text` (JSON or TOML) into `T`; errors name `origin` with line and column.
+/// The key whose value is being read at byte `offset` of `text`: the last
+/// `"key":` (JSON) or `key =` (TOML) before it. Parameter files are flat, so
+/// this names the parameter a value error is about.
+fn key_before(text: &str, offset: usize, is_toml: bool) -> Option<String> {
+    let mut end = offset.min(text.len());
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    let prefix = &text[..end];
+    if is_toml {
+        return prefix.lines().rev().find_map(|l| {
+            let (k, _) = l.split_once('=')?;
+            let k = k.trim().trim_matches('"');
+            (!k.is_empty() && k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-'))
+                .then(|| k.to_string())
+        });
+    }
+    // JSON: scan strings; a string followed by `:` is a key.
+    let b = prefix.as_bytes();
+    let (mut i, mut last) = (0, None);
+    while i < b.len() {
+        if b[i] == b'"' {
+            let start = i + 1;
+            let mut j = start;
+            while j < b.len() && b[j] != b'"' {
+                j += if b[j] == b'\\' { 2 } else { 1 };
+            }
+            let mut k = j + 1;
+            while k < b.len() && b[k].is_ascii_whitespace() {
+                k += 1;
+            }
+            if k < b.len() && b[k] == b':' && j <= b.len() {
+                last = Some(prefix[start..j.min(b.len())].to_string());
+            }
+            i = j + 1;
+        } else {
+            i += 1;
+        }
+    }
+    last
+}
+
+/// `message`, prefixed with the parameter it is about when that is not already named.
+fn name_parameter(message: String, text: &str, offset: usize, is_toml: bool) -> String {
+    let about_keys = ["missing field", "unknown field", "duplicate field", "duplicate key"];
+    if about_keys.iter().any(|k| message.contains(k)) {
+        return message;
+    }
+    match key_before(text, offset, is_toml) {
+        Some(k) if !message.contains(&format!("`{k}`")) => format!("parameter `{k}`: {message}"),
+        _ => message,
+    }
+}
+
+/// Parses `text` (JSON or TOML) into `T`; errors name `origin` with line and
+/// column, and the parameter whose value is wrong.
 pub fn parse_text<T: DeserializeOwned>(text: &str, origin: &str, is_toml: bool) -> Result<T, DataError> {
+    let text = crate::text::strip_bom(text);
     if is_toml {
         toml::from_str::<T>(text).map_err(|e| {
-            let (line, column) = e
-                .span()
-                .map(|sp| {
-                    let before = &text[..sp.start.min(text.len())];
+            let start = e.span().map(|sp| sp.start.min(text.len()));
+            let (line, column) = start
+                .map(|start| {
+                    let before = &text[..start];
                     let line = before.matches('\n').count() + 1;
-                    let col = sp.start - before.rfind('\n').map(|p| p + 1).unwrap_or(0) + 1;
+                    let col = start - before.rfind('\n').map(|p| p + 1).unwrap_or(0) + 1;
                     (line, col)
                 })
                 .unwrap_or((0, 0));
+            let message = e.message().to_string();
             DataError::Syntax {
                 file: origin.to_string(),
                 line,
                 column,
-                message: e.message().to_string(),
+                message: match start {
+                    Some(o) => name_parameter(message, text, o, true),
+                    None => message,
+                },
             }
         })
     } else {
-        serde_json::from_str::<T>(text).map_err(|e| DataError::Syntax {
-            file: origin.to_string(),
-            line: e.line(),
-            column: e.column(),
-            message: e.to_string().split(" at line ").next().unwrap_or("").to_string(),
+        serde_json::from_str::<T>(text).map_err(|e| {
+            let message = e.to_string().split(" at line ").next().unwrap_or("").to_string();
+            // Byte offset of (line, column); serde_json's column is 1-based in bytes.
+            let offset = text
+                .split_inclusive('\n')
+                .take(e.line().saturating_sub(1))
+                .map(str::len)
+                .sum::<usize>()
+                + e.column().saturating_sub(1);
+            DataError::Syntax {
+                file: origin.to_string(),
+                line: e.line(),
+                column: e.column(),
+                message: name_parameter(message, text, offset, false),
+            }
         })
     }
 }
@@ -121,6 +188,49 @@ mod tests {
         let p = load_params::<PaperParams>(GOOD).unwrap();
         assert!(p.value.is_rgb());
         p.value.validate().unwrap();
+    }
+
+    #[test]
+    fn byte_order_mark_is_ignored_in_json_and_toml() {
+        // Issue 16: a UTF-8 BOM gave `1:1: expected value` for JSON files.
+        let d = tempfile::tempdir().unwrap();
+        let j = d.path().join("p.json");
+        std::fs::write(&j, format!("\u{feff}{GOOD}")).unwrap();
+        let p = load_params::<PaperParams>(j.to_str().unwrap()).unwrap();
+        p.value.validate().unwrap();
+        assert!(!p.text.starts_with('\u{feff}'));
+        let t = d.path().join("p.toml");
+        let toml = "\u{feff}d = 0.1\nsigma_a = 0.6\nsigma_s = 100\ng_f = 0.8\ng_b = -0.3\nw_b = 0.5\neta_f = 1.5\neta_b = 1.5\nm_f = 0.3\nm_b = 0.3\ndist_f = \"ggx\"\ndist_b = \"beckmann\"\n";
+        std::fs::write(&t, toml).unwrap();
+        load_params::<PaperParams>(t.to_str().unwrap()).unwrap();
+        // Text given directly (not from a file) is handled the same way.
+        parse_text::<PaperParams>(&format!("\u{feff}{GOOD}"), "<x>", false).unwrap();
+    }
+
+    #[test]
+    fn wrong_length_rgb_names_parameter_and_forms() {
+        // Issue 16: this said `data did not match any variant of untagged enum Colour`.
+        let bad = GOOD.replace("[120,110,100]", "[120,110]");
+        let e = load_params::<PaperParams>(&bad).unwrap_err().to_string();
+        assert!(
+            e.contains("parameter `sigma_s`") && e.contains("array of 2 numbers") && e.contains("RGB triple"),
+            "{e}"
+        );
+        let bad = GOOD.replace("[120,110,100]", "[1,2,3,4]");
+        let e = load_params::<PaperParams>(&bad).unwrap_err().to_string();
+        assert!(e.contains("parameter `sigma_s`") && e.contains("array of 4"), "{e}");
+        let bad = GOOD.replace("\"sigma_a\":0.6", "\"sigma_a\":\"red\"");
+        let e = load_params::<PaperParams>(&bad).unwrap_err().to_string();
+        assert!(
+            e.contains("parameter `sigma_a`") && e.contains("a number or an RGB triple"),
+            "{e}"
+        );
+        let toml = "d = 0.1\nsigma_a = 0.6\nsigma_s = [1, 2]\ng_f = 0.8\n";
+        let e = parse_text::<PaperParams>(toml, "p.toml", true).unwrap_err().to_string();
+        assert!(
+            e.contains("p.toml:3:") && e.contains("sigma_s") && e.contains("RGB triple"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -255,10 +255,10 @@ fn y_range(panel: &Panel, log_y: bool) -> (f64, f64) {
     }
 }
 
-fn draw_err<E: std::fmt::Debug>(file: &str) -> impl Fn(E) -> PlotError + '_ {
+fn draw_err<E: std::fmt::Display>(file: &str) -> impl Fn(E) -> PlotError + '_ {
     move |e| PlotError::Draw {
         file: file.to_string(),
-        message: format!("{e:?}"),
+        message: e.to_string(),
     }
 }
 
@@ -419,38 +419,38 @@ pub fn draw_figure(fig: &Figure, path: &Path) -> Result<(), PlotError> {
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    let size = figure_size(fig);
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
-    let stem = path
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{stem}.{}.tmp.{ext}", std::process::id()));
-    let result = match ext.as_str() {
-        "png" => {
-            let root = BitMapBackend::new(&tmp, size).into_drawing_area();
-            draw_on(root, fig, &file)
-        }
-        "svg" => {
-            let root = SVGBackend::new(&tmp, size).into_drawing_area();
-            draw_on(root, fig, &file)
-        }
-        _ => {
-            return Err(PlotError::Invalid {
-                file,
-                message: format!("unknown figure type `.{ext}`: use .png or .svg"),
-            })
-        }
-    };
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e);
+    if ext != "png" && ext != "svg" {
+        return Err(PlotError::Invalid {
+            file,
+            message: format!("unknown figure type `.{ext}`: use .png or .svg"),
+        });
     }
-    std::fs::rename(&tmp, path).map_err(|source| {
-        let _ = std::fs::remove_file(&tmp);
-        PlotError::Io { file, source }
+    let size = figure_size(fig);
+    // The shared atomic writer: output directory checked, links written
+    // through, non-regular targets refused, no temporary file left behind.
+    let message = |e: PlotError| match e {
+        PlotError::Draw { message, .. } => format!("drawing failed: {message}"),
+        other => other.to_string(),
+    };
+    paperbsdf_io::atomic::write_atomic_with(path, |tmp| {
+        if ext == "png" {
+            draw_on(BitMapBackend::new(tmp, size).into_drawing_area(), fig, &file).map_err(message)
+        } else {
+            draw_on(SVGBackend::new(tmp, size).into_drawing_area(), fig, &file).map_err(message)
+        }
+    })
+    .map_err(|e| match e {
+        paperbsdf_io::DataError::Io { source, .. } => PlotError::Io {
+            file: file.clone(),
+            source,
+        },
+        paperbsdf_io::DataError::Other { message, .. } => PlotError::Invalid {
+            file: file.clone(),
+            message,
+        },
+        other => PlotError::Invalid {
+            file: file.clone(),
+            message: other.to_string(),
+        },
     })
 }

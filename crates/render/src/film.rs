@@ -7,7 +7,7 @@
 //! transfer function (IEC 61966-2-1).
 
 use paperbsdf_core::Rgb;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Per-pixel accumulators; pixel `(x, y)` is at index `y * width + x`, `(0, 0)` top-left.
 #[derive(Clone, Debug)]
@@ -70,26 +70,11 @@ impl Film {
     }
 }
 
-/// A temporary sibling of `path` for an atomic write.
-fn temp_sibling(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    path.with_file_name(format!(".{name}.tmp{}", std::process::id()))
-}
-
-/// Writes `write(tmp)` then renames it to `path`.
+/// Writes `write(tmp)` then renames it to `path`, with the project's shared
+/// atomic writer (symbolic links written through, non-regular targets refused,
+/// temporary files removed by the Ctrl-C handler).
 fn atomic(path: &Path, write: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), String> {
-    let tmp = temp_sibling(path);
-    if let Err(e) = write(&tmp) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e);
-    }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("cannot rename to '{}': {e}", path.display())
-    })
+    paperbsdf_io::atomic::write_atomic_with(path, write).map_err(|e| e.to_string())
 }
 
 /// Writes a linear RGB image (row-major, top row first) as 32-bit float OpenEXR, atomically.

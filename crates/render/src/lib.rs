@@ -184,17 +184,60 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
 
 /// Installs a Ctrl-C handler that sets the returned flag (the render then stops
 /// at the next tile and the partial image is still written). A second Ctrl-C
-/// exits at once. Fails if a handler is installed already.
+/// removes every temporary output file being written and exits at once with
+/// code 130. Fails if a handler is installed already.
 pub fn install_ctrlc_flag() -> Result<&'static AtomicBool, String> {
     static FLAG: AtomicBool = AtomicBool::new(false);
     ctrlc::set_handler(|| {
         if FLAG.swap(true, Ordering::SeqCst) {
+            paperbsdf_io::atomic::remove_temp_files();
             std::process::exit(130);
         }
         eprintln!("\ninterrupted: finishing the current tiles and writing the partial image (Ctrl-C again to quit)");
     })
     .map_err(|e| format!("cannot install the Ctrl-C handler: {e}"))?;
     Ok(&FLAG)
+}
+
+/// Bytes a render of `width x height` pixels holds at its peak: the film's
+/// sums, squares and counts (52 bytes a pixel), one pass of tile results (48),
+/// the mean image (24) and the encoders' buffers (EXR 12, PNG 3), with 10%
+/// for allocator slack: about 153 bytes a pixel (2.6 GB at 4096 x 4096).
+pub fn estimate_memory_bytes(width: usize, height: usize) -> f64 {
+    (52.0 + 48.0 + 24.0 + 12.0 + 3.0) * 1.1 * width as f64 * height as f64
+}
+
+/// Memory this process may use, bytes: the smallest of the machine's
+/// available memory (`MemAvailable` in `/proc/meminfo`) and the cgroup's
+/// limit (`memory.max`, v2); `None` where neither can be read.
+pub fn available_memory_bytes() -> Option<f64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|t| {
+        t.lines()
+            .find_map(|l| l.strip_prefix("MemAvailable:"))
+            .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
+            .map(|kb| kb * 1024.0)
+    });
+    let cgroup = std::fs::read_to_string("/sys/fs/cgroup/memory.max")
+        .ok()
+        .and_then(|t| t.trim().parse::<f64>().ok());
+    match (meminfo, cgroup) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
+}
+
+/// Refuses an image whose estimated memory ([`estimate_memory_bytes`]) is more
+/// than `available` bytes, with both numbers in the message.
+pub fn check_memory(width: usize, height: usize, available: Option<f64>) -> Result<(), String> {
+    let need = estimate_memory_bytes(width, height);
+    match available {
+        Some(a) if need > a => Err(format!(
+            "a {width}x{height} render needs about {:.1} GB of memory, more than the {:.1} GB available; use a smaller --width/--height",
+            need / 1e9,
+            a / 1e9
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// [`render`] on a pool of `threads` workers (`None`: one per core); also returns the number of workers.
@@ -207,6 +250,7 @@ pub fn render_with_threads(
     if threads == Some(0) {
         return Err("--threads must be at least 1".into());
     }
+    check_memory(scene.settings.width, scene.settings.height, available_memory_bytes())?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()

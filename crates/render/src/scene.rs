@@ -28,17 +28,34 @@ pub struct Camera {
     pub tan_half: f64,
 }
 
+/// Smallest sine of the angle between a camera's `up` and its view direction
+/// (1e-4: 0.0057 degrees; closer, the image's roll is decided by rounding).
+pub const UP_MIN_SIN: f64 = 1e-4;
+
 impl Camera {
     /// A camera at `origin` looking at `target` with approximate `up`; `fov_x_deg` is the horizontal field of view.
+    /// `up` (any length) must make an angle whose sine is at least [`UP_MIN_SIN`]
+    /// with the view direction.
     pub fn look_at(origin: DVec3, target: DVec3, up: DVec3, fov_x_deg: f64) -> Result<Camera, String> {
         let forward = (target - origin).normalize_or_zero();
         if forward == DVec3::ZERO {
             return Err("camera origin and target coincide".into());
         }
-        let right = forward.cross(up).normalize_or_zero();
-        if right == DVec3::ZERO {
-            return Err("camera `up` is parallel to the viewing direction".into());
+        // Parallel within a tolerance: rounding makes the cross product of
+        // parallel vectors tiny but not zero, and normalising it would give a
+        // meaningless roll.
+        let up_n = up.normalize_or_zero();
+        let sin = forward.cross(up_n).length();
+        if sin.is_nan() || sin < UP_MIN_SIN {
+            return Err(format!(
+                "camera `up` = ({}, {}, {}) is parallel to the viewing direction (the angle between them must be at least {:.4} degrees)",
+                up.x,
+                up.y,
+                up.z,
+                UP_MIN_SIN.asin().to_degrees()
+            ));
         }
+        let right = forward.cross(up_n).normalize();
         if !(fov_x_deg > 0.0 && fov_x_deg < 180.0) {
             return Err(format!("camera fov = {fov_x_deg} is outside (0, 180) degrees"));
         }

@@ -77,8 +77,9 @@ pub struct EnvironmentSpec {
 }
 
 /// A colour: a number, an RGB triple, or a texture table.
-#[derive(Deserialize, Debug, Clone)]
-#[serde(untagged)]
+/// Deserialised by hand so that a wrong form (an array of 2, a string) is an
+/// error that says which forms are accepted.
+#[derive(Debug, Clone)]
 pub enum ColourSpec {
     /// One value for all channels.
     Scalar(f64),
@@ -86,6 +87,48 @@ pub enum ColourSpec {
     Rgb([f64; 3]),
     /// A texture.
     Texture(TextureSpec),
+}
+
+impl<'de> Deserialize<'de> for ColourSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        const EXPECTED: &str =
+            "a number, an RGB triple [r, g, b] of exactly 3 numbers, or a texture table { type = ... }";
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = ColourSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(EXPECTED)
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<ColourSpec, E> {
+                Ok(ColourSpec::Scalar(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<ColourSpec, E> {
+                Ok(ColourSpec::Scalar(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<ColourSpec, E> {
+                Ok(ColourSpec::Scalar(v as f64))
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<ColourSpec, A::Error> {
+                let (mut c, mut n) = ([0.0; 3], 0usize);
+                while let Some(v) = seq.next_element::<f64>()? {
+                    if n < 3 {
+                        c[n] = v;
+                    }
+                    n += 1;
+                }
+                if n != 3 {
+                    return Err(serde::de::Error::custom(format!(
+                        "an array of {n} numbers; expected {EXPECTED}"
+                    )));
+                }
+                Ok(ColourSpec::Rgb(c))
+            }
+            fn visit_map<M: serde::de::MapAccess<'de>>(self, map: M) -> Result<ColourSpec, M::Error> {
+                TextureSpec::deserialize(serde::de::value::MapAccessDeserializer::new(map)).map(ColourSpec::Texture)
+            }
+        }
+        d.deserialize_any(V)
+    }
 }
 
 /// `{ type = "checker", even = .., odd = .., scale = .. }` or `{ type = "image", file = "..", scale = .. }`.
@@ -812,12 +855,38 @@ fn transform_tris(shapes: Vec<Shape>, a: &Affine) -> Vec<Shape> {
         .collect()
 }
 
+/// Checks that every number of the OBJ file's `v`, `vn` and `vt` lines is
+/// finite (tobj reads `nan` and `inf` as numbers); the error names the line.
+fn check_obj_numbers(path: &Path) -> Result<(), String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("cannot load OBJ '{}': {e}", path.display()))?;
+    let text = String::from_utf8_lossy(&bytes);
+    for (i, line) in text.lines().enumerate() {
+        let mut it = line.split_whitespace();
+        let Some(kw @ ("v" | "vn" | "vt")) = it.next() else {
+            continue;
+        };
+        for x in it {
+            if let Ok(v) = x.parse::<f64>() {
+                if !v.is_finite() {
+                    return Err(format!(
+                        "OBJ '{}' line {}: `{kw}` has the non-finite number `{x}`",
+                        path.display(),
+                        i + 1
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 fn load_obj(path: &Path, a: &Affine) -> Result<Vec<Shape>, String> {
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ..Default::default()
     };
+    check_obj_numbers(path)?;
     let (models, _) = tobj::load_obj(path, &opts).map_err(|e| format!("cannot load OBJ '{}': {e}", path.display()))?;
     let mut out = vec![];
     for m in &models {

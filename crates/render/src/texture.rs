@@ -31,17 +31,41 @@ fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
+/// Largest width or height of a texture image, pixels.
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+/// Largest decoding allocation of a texture image, bytes (256 MiB; the linear
+/// float copy made from it is up to four times larger).
+pub const MAX_IMAGE_BYTES: u64 = 256 << 20;
+
 impl Image {
     /// Decodes an image file (PNG) as linear RGB (`grey = false`, sRGB decoded)
     /// or as a greyscale map (`grey = true`, values as stored).
+    /// Images larger than [`MAX_IMAGE_SIDE`] on a side, or needing more than
+    /// [`MAX_IMAGE_BYTES`] to decode, are refused before anything is allocated.
     pub fn load(path: &Path, grey: bool) -> Result<Image, String> {
-        let img = image::open(path).map_err(|e| format!("cannot read image '{}': {e}", path.display()))?;
-        Ok(Self::from_dynamic(img, grey))
+        let e = |e: image::ImageError| format!("cannot read image '{}': {e}", path.display());
+        let mut r = image::ImageReader::open(path)
+            .map_err(|x| e(x.into()))?
+            .with_guessed_format()
+            .map_err(|x| e(x.into()))?;
+        r.limits(Self::limits());
+        Ok(Self::from_dynamic(r.decode().map_err(e)?, grey))
     }
-    /// Decodes an image held in memory (built-in scenes embed their masks).
+    /// Decodes an image held in memory (built-in scenes embed their masks), with the limits of [`Image::load`].
     pub fn from_bytes(bytes: &[u8], grey: bool) -> Result<Image, String> {
-        let img = image::load_from_memory(bytes).map_err(|e| format!("cannot decode embedded image: {e}"))?;
-        Ok(Self::from_dynamic(img, grey))
+        let e = |e: image::ImageError| format!("cannot decode embedded image: {e}");
+        let mut r = image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|x| e(x.into()))?;
+        r.limits(Self::limits());
+        Ok(Self::from_dynamic(r.decode().map_err(e)?, grey))
+    }
+    fn limits() -> image::Limits {
+        let mut l = image::Limits::default();
+        l.max_image_width = Some(MAX_IMAGE_SIDE);
+        l.max_image_height = Some(MAX_IMAGE_SIDE);
+        l.max_alloc = Some(MAX_IMAGE_BYTES);
+        l
     }
     fn from_dynamic(img: image::DynamicImage, grey: bool) -> Image {
         let (width, height) = (img.width() as usize, img.height() as usize);

@@ -164,6 +164,23 @@ fn mesh_that_fails_to_load() {
     std::fs::write(dir.path().join("statue.obj"), "v 0 zero 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     let m = load_err(dir.path(), &scene);
     contains_all(&m, &["shapes[3] (statue)", "statue.obj"]);
+    // Issue 16: a `nan` (or `inf`) vertex was accepted; it is refused with the line.
+    for bad in ["nan", "inf", "-inf", "NaN"] {
+        std::fs::write(
+            dir.path().join("statue.obj"),
+            format!("# mesh\nv 0 0 0\nv 1 {bad} 0\nv 0 1 0\nf 1 2 3\n"),
+        )
+        .unwrap();
+        let m = load_err(dir.path(), &scene);
+        contains_all(&m, &["shapes[3] (statue)", "statue.obj", "line 3", bad, "non-finite"]);
+    }
+    std::fs::write(
+        dir.path().join("statue.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 nan 1\nf 1 2 3\n",
+    )
+    .unwrap();
+    let m = load_err(dir.path(), &scene);
+    contains_all(&m, &["statue.obj", "line 4", "vn"]);
     // No triangles at all.
     std::fs::write(dir.path().join("statue.obj"), "# empty\nv 0 0 0\n").unwrap();
     let m = load_err(dir.path(), &scene);
@@ -273,4 +290,37 @@ fn paper_parameter_file() {
     // Both a preset and a file.
     let m = load_err(dir.path(), &scene.replace("d = 0.2", "preset = \"matte\""));
     contains_all(&m, &["materials.sheet", "preset", "params"]);
+}
+
+/// Issue 16: `up` parallel to the view direction was caught only when the
+/// cross product came out exactly zero; rounding usually leaves a tiny one.
+#[test]
+fn camera_up_parallel_within_tolerance() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut slipped_through_before = false;
+    for k in [1.0, 0.1, 0.3, 7.0, -0.7, 1e-3] {
+        let (y, z) = (3.0 * k, -k);
+        // The old check: the cross product of the normalised view direction and `up` exactly zero.
+        let f = glam::DVec3::new(0.0, 3.0, -1.0).normalize();
+        slipped_through_before |= f.cross(glam::DVec3::new(0.0, y, z)) != glam::DVec3::ZERO;
+        let scene = GOOD.replace("fov = 40", &format!("fov = 40\nup = [0, {y:e}, {z:e}]"));
+        let m = load_err(dir.path(), &scene);
+        contains_all(&m, &["camera", "up", "parallel", "degrees"]);
+    }
+    assert!(
+        slipped_through_before,
+        "no case tested the rounding the old check missed"
+    );
+    // Nearly parallel, but 0.01 degrees off: accepted.
+    let t = 0.01f64.to_radians();
+    let f = glam::DVec3::new(0.0, 3.0, -1.0).normalize();
+    let side = glam::DVec3::X;
+    let up = f * t.cos() + side * t.sin();
+    let scene = GOOD.replace(
+        "fov = 40",
+        &format!("fov = 40\nup = [{:e}, {:e}, {:e}]", up.x, up.y, up.z),
+    );
+    let p = dir.path().join("ok.toml");
+    std::fs::write(&p, scene).unwrap();
+    load_scene(&p).unwrap();
 }

@@ -8,9 +8,19 @@
 //! whatever other directions are simulated with it. The standard error of each
 //! estimate is the standard deviation of the batch means over `sqrt(batches)`
 //! (all batches have the same number of walks).
+//!
+//! Limits: at most [`MAX_BATCHES`] batches; each walk is cut after
+//! [`MAX_COLLISIONS_PER_WALK`] collisions, and the runs report how many walks
+//! were cut ([`BsdfRun::truncated`]) so that a cut never biases a result
+//! silently. [`estimate_work`] predicts the collisions a run will take (for a
+//! refusal before absurd runs), and the achieved precision is reported
+//! ([`BsdfRun::worst_rel_stderr`], [`BsdfRun::target_reached`]). When standard
+//! error is not a terminal, progress is printed as a line every
+//! [`PLAIN_PROGRESS_SECONDS`] seconds instead of a bar (the environment
+//! variable `PAPERBSDF_PROGRESS_SECONDS` sets another interval, e.g. for logs).
 
 use crate::slab::Slab;
-use crate::walk::{Tally, Tracer};
+use crate::walk::{Tally, Tracer, MAX_COLLISIONS_PER_WALK};
 use indicatif::{ProgressBar, ProgressStyle};
 use paperbsdf_core::geometry::sample_cosine_hemisphere;
 use paperbsdf_core::{DVec3, Rgb};
@@ -30,6 +40,13 @@ static COLLISIONS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::
 pub fn collisions_so_far() -> u64 {
     COLLISIONS.load(std::sync::atomic::Ordering::Relaxed)
 }
+
+/// Largest number of batches (each holds a vector of means; more batches add
+/// nothing to the standard error's accuracy, which is already 1 part in 300).
+pub const MAX_BATCHES: u32 = 100_000;
+
+/// Seconds between progress lines when standard error is not a terminal.
+pub const PLAIN_PROGRESS_SECONDS: u64 = 10;
 
 /// How many walks to run and how.
 #[derive(Clone, Debug, PartialEq)]
@@ -119,6 +136,15 @@ pub struct BsdfRun {
     pub by_order: Option<Vec<[Estimate; 3]>>,
     /// Walks run per colour channel.
     pub samples: u64,
+    /// Walks (over all channels) cut at [`MAX_COLLISIONS_PER_WALK`]
+    /// collisions; each carried at most unit flux, so at most
+    /// `truncated / samples` of the incident flux is missing. Zero for paper.
+    pub truncated: u64,
+    /// Largest `stderr / mean` over every estimate with a positive mean (0 when none).
+    pub worst_rel_stderr: f64,
+    /// With [`SimConfig::rel_stderr`]: whether the target was reached (else
+    /// `max_samples` stopped the run). `true` without a target.
+    pub target_reached: bool,
 }
 
 /// Totals of [`simulate_totals`].
@@ -130,6 +156,12 @@ pub struct Totals {
     pub transmittance: Estimate,
     /// Walks run per colour channel.
     pub samples: u64,
+    /// Walks cut at [`MAX_COLLISIONS_PER_WALK`] collisions (see [`BsdfRun::truncated`]).
+    pub truncated: u64,
+    /// Largest `stderr / mean` over the estimates with a positive mean.
+    pub worst_rel_stderr: f64,
+    /// Whether the `rel_stderr` target was reached (see [`BsdfRun::target_reached`]).
+    pub target_reached: bool,
 }
 
 /// How the incident light is distributed.
@@ -157,11 +189,18 @@ fn check_dir(what: &'static str, w: DVec3) -> Result<(), SimError> {
 }
 
 fn check_config(c: &SimConfig) -> Result<(), SimError> {
-    if c.batches < 2 {
+    if c.batches < 2 || c.batches > MAX_BATCHES {
         return Err(SimError::BadConfig {
             name: "batches",
             value: c.batches as f64,
-            message: "need at least 2 batches",
+            message: "need 2 to 100000 batches",
+        });
+    }
+    if c.rel_stderr.is_some() && c.max_samples == 0 {
+        return Err(SimError::BadConfig {
+            name: "max_samples",
+            value: 0.0,
+            message: "need at least one walk",
         });
     }
     if c.samples == 0 {
@@ -183,6 +222,30 @@ fn check_config(c: &SimConfig) -> Result<(), SimError> {
     Ok(())
 }
 
+/// Largest optical thickness `sigma_t * d` simulated. Beyond it the mean free
+/// path is below 1e-9 of the thickness, a few million units in the last place
+/// of a depth near the back face, and rounding of the positions (subnormal
+/// numbers near the front face for `sigma_s = 1e308`) biases the walk: such a
+/// slab would give a wrong answer quietly, so it is refused. Paper is 10 to 100.
+pub const MAX_OPTICAL_THICKNESS: f64 = 1e9;
+
+/// Refuses a slab thicker than [`MAX_OPTICAL_THICKNESS`] in any channel.
+pub fn check_slab(slab: &Slab) -> Result<(), SimError> {
+    for c in 0..3 {
+        let tau = slab.medium(c).sigma_t * slab.d;
+        if tau.is_nan() || tau > MAX_OPTICAL_THICKNESS {
+            return Err(SimError::BadConfig {
+                name: "sigma_t * d",
+                value: tau,
+                message: "the slab is more than 1e9 mean free paths thick (sigma_t = sigma_a + sigma_s times d): \
+the walk's depths cannot be resolved in double precision and the result would be wrong; \
+nothing physical is that thick (paper is 10 to 100)",
+            });
+        }
+    }
+    Ok(())
+}
+
 /// SplitMix64 finaliser, to derive independent seeds.
 fn mix(mut z: u64) -> u64 {
     z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
@@ -198,9 +261,31 @@ fn incidence_key(inc: Incidence) -> u64 {
     }
 }
 
+/// What a run did besides its estimates.
+struct RunStats {
+    samples: u64,
+    truncated: u64,
+    worst_rel_stderr: f64,
+    target_reached: bool,
+}
+
+/// Largest `stderr / mean` over the estimates with a positive mean.
+fn worst_rel(est: &[Estimate]) -> f64 {
+    let mut worst: f64 = 0.0;
+    for e in est {
+        for k in 0..3 {
+            if e.mean.0[k] > 0.0 {
+                worst = worst.max(e.stderr.0[k] / e.mean.0[k]);
+            }
+        }
+    }
+    worst
+}
+
 /// Runs the walks of one incident light distribution: batch means per
 /// channel, each a vector `[f_0, .., f_{n-1}, R, T]`.
-fn run(slab: &Slab, inc: Incidence, wos: &[DVec3], cfg: &SimConfig, pb: &ProgressBar) -> (Vec<Estimate>, u64) {
+fn run(slab: &Slab, inc: Incidence, wos: &[DVec3], cfg: &SimConfig, pb: &ProgressBar) -> (Vec<Estimate>, RunStats) {
+    let truncated = std::sync::atomic::AtomicU64::new(0);
     let reps = slab.distinct_channels();
     let channels: Vec<usize> = (0..3).filter(|&c| reps[c] == c).collect();
     let nb = cfg.batches as u64;
@@ -243,6 +328,7 @@ fn run(slab: &Slab, inc: Incidence, wos: &[DVec3], cfg: &SimConfig, pb: &Progres
         }
         pb.inc(per_batch % 256);
         COLLISIONS.fetch_add(sum.collisions, std::sync::atomic::Ordering::Relaxed);
+        truncated.fetch_add(sum.truncated, std::sync::atomic::Ordering::Relaxed);
         let inv = 1.0 / per_batch as f64;
         let mut v: Vec<f64> = sum.f.iter().map(|x| x * inv).collect();
         v.push(sum.r * inv);
@@ -270,21 +356,21 @@ fn run(slab: &Slab, inc: Incidence, wos: &[DVec3], cfg: &SimConfig, pb: &Progres
         }
         done_batches = target_batches;
         let est = summarise(&batch_means, &reps, n_out);
+        let achieved = worst_rel(&est);
+        let stats = |reached: bool| RunStats {
+            samples: done_batches * per_batch,
+            truncated: truncated.load(std::sync::atomic::Ordering::Relaxed),
+            worst_rel_stderr: achieved,
+            target_reached: reached,
+        };
         let Some(x) = cfg.rel_stderr else {
-            return (est, done_batches * per_batch);
+            return (est, stats(true));
         };
         // Worst ratio (stderr / (x mean)) over estimates with a positive mean.
-        let mut worst: f64 = 0.0;
-        for e in &est {
-            for k in 0..3 {
-                if e.mean.0[k] > 0.0 {
-                    worst = worst.max(e.stderr.0[k] / (x * e.mean.0[k]));
-                }
-            }
-        }
+        let worst = achieved / x;
         let max_batches = (cfg.max_samples / per_batch).max(nb);
         if worst <= 1.0 || done_batches >= max_batches {
-            return (est, done_batches * per_batch);
+            return (est, stats(worst <= 1.0));
         }
         // Walks needed scale with the square of the ratio; add 10% and at least one round's worth / 4.
         let need = ((done_batches as f64) * worst * worst * 1.1).ceil() as u64;
@@ -314,11 +400,45 @@ fn summarise(batch_means: &[Vec<Vec<f64>>], reps: &[usize; 3], n_out: usize) -> 
     out
 }
 
+/// Prints `pb`'s position as a line on standard error every
+/// [`PLAIN_PROGRESS_SECONDS`] while `work` runs, when standard error is not a
+/// terminal (indicatif draws nothing then); returns `work`'s result.
+fn with_plain_progress<T: Send>(cfg: &SimConfig, pb: &ProgressBar, msg: &str, work: impl FnOnce() -> T + Send) -> T {
+    use std::io::IsTerminal;
+    if !cfg.progress || std::io::stderr().is_terminal() {
+        return work();
+    }
+    let (tx, rx) = std::sync::mpsc::channel::<()>();
+    std::thread::scope(|s| {
+        s.spawn(move || {
+            let start = std::time::Instant::now();
+            let secs = std::env::var("PAPERBSDF_PROGRESS_SECONDS")
+                .ok()
+                .and_then(|v| v.parse::<f64>().ok())
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .unwrap_or(PLAIN_PROGRESS_SECONDS as f64);
+            let every = std::time::Duration::from_secs_f64(secs.min(1e6));
+            while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = rx.recv_timeout(every) {
+                let (pos, len) = (pb.position(), pb.length().unwrap_or(0));
+                eprintln!(
+                    "{msg}: {pos} of {len} walks ({:.0}%) after {:.0} s",
+                    100.0 * pos as f64 / len.max(1) as f64,
+                    start.elapsed().as_secs_f64()
+                );
+            }
+        });
+        let out = work();
+        drop(tx);
+        out
+    })
+}
+
 fn progress_bar(cfg: &SimConfig, msg: &str) -> ProgressBar {
     if !cfg.progress {
         return ProgressBar::hidden();
     }
-    let pb = ProgressBar::new(0);
+    // Counts positions even when nothing is drawn (standard error not a terminal).
+    let pb = ProgressBar::with_draw_target(Some(0), indicatif::ProgressDrawTarget::stderr());
     pb.set_style(
         ProgressStyle::with_template("{msg} [{elapsed_precise}] {wide_bar} {pos}/{len} walks ({per_sec}, eta {eta})")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -332,12 +452,15 @@ fn progress_bar(cfg: &SimConfig, msg: &str) -> ProgressBar {
 /// reflectance and transmittance of the same walks.
 pub fn simulate_bsdf(slab: &Slab, wi: DVec3, wos: &[DVec3], cfg: &SimConfig) -> Result<BsdfRun, SimError> {
     check_config(cfg)?;
+    check_slab(slab)?;
     check_dir("wi", wi)?;
     for &wo in wos {
         check_dir("wo", wo)?;
     }
     let pb = progress_bar(cfg, "simulate");
-    let (est, samples) = run(slab, Incidence::Collimated(wi), wos, cfg, &pb);
+    let (est, st) = with_plain_progress(cfg, &pb, "simulate", || {
+        run(slab, Incidence::Collimated(wi), wos, cfg, &pb)
+    });
     pb.finish_and_clear();
     let n = wos.len();
     let by_order = cfg.by_order.then(|| {
@@ -350,7 +473,10 @@ pub fn simulate_bsdf(slab: &Slab, wi: DVec3, wos: &[DVec3], cfg: &SimConfig) -> 
         reflectance: est[n],
         transmittance: est[n + 1],
         by_order,
-        samples,
+        samples: st.samples,
+        truncated: st.truncated,
+        worst_rel_stderr: st.worst_rel_stderr,
+        target_reached: st.target_reached,
     })
 }
 
@@ -358,15 +484,91 @@ pub fn simulate_bsdf(slab: &Slab, wi: DVec3, wos: &[DVec3], cfg: &SimConfig) -> 
 /// diffuse incident light.
 pub fn simulate_totals(slab: &Slab, inc: Incidence, cfg: &SimConfig) -> Result<Totals, SimError> {
     check_config(cfg)?;
+    check_slab(slab)?;
     if let Incidence::Collimated(wi) = inc {
         check_dir("wi", wi)?;
     }
     let pb = progress_bar(cfg, "totals");
-    let (est, samples) = run(slab, inc, &[], cfg, &pb);
+    let (est, st) = with_plain_progress(cfg, &pb, "totals", || run(slab, inc, &[], cfg, &pb));
     pb.finish_and_clear();
     Ok(Totals {
         reflectance: est[0],
         transmittance: est[1],
-        samples,
+        samples: st.samples,
+        truncated: st.truncated,
+        worst_rel_stderr: st.worst_rel_stderr,
+        target_reached: st.target_reached,
     })
+}
+
+/// The predicted cost of a run, from the slab's optical properties.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Work {
+    /// Predicted mean collisions per walk (worst colour channel).
+    pub collisions_per_walk: f64,
+    /// Walks over all channels (the first round's with `rel_stderr`; `max_samples` for `max_walks`).
+    pub walks: f64,
+    /// `walks * collisions_per_walk`.
+    pub collisions: f64,
+    /// The same with `rel_stderr` when every round up to `max_samples` is run.
+    pub max_collisions: f64,
+}
+
+/// Predicted mean number of collisions of a walk in channel medium `m` of a
+/// slab of thickness `d`, mm, between faces of relative index `eta` (the larger
+/// one). Three bounds, the smallest applies: a random walk started near a face
+/// leaves a slab of optical thickness `tau` after about `tau` collisions (mean
+/// exit time of a walk one step from the edge of a strip `tau` wide), times
+/// the returns from the faces' total internal reflection, `1 / (1 - R_int)`
+/// with `R_int = 1 - 1 / eta^2` for diffuse light inside; absorption ends it
+/// after about `6 / (1 - albedo)` (weight 0.01 then Russian roulette with
+/// survival 0.1); and the per-walk cap makes the heavy tail of a conservative
+/// half-space (`P(N > n) ~ n^-1/2`) cost about `2 sqrt(MAX_COLLISIONS_PER_WALK)`.
+/// An order-of-magnitude model, checked to a factor of 3 in `tests/limits.rs`.
+pub fn collisions_per_walk(m: crate::slab::Medium, d: f64, eta: f64) -> f64 {
+    let tau = m.sigma_t * d;
+    let returns = eta.max(1.0).powi(2);
+    let absorb = 6.0 / (1.0 - m.albedo).max(f64::MIN_POSITIVE);
+    let cap = 2.0 * (MAX_COLLISIONS_PER_WALK as f64).sqrt();
+    1.0 + (m.albedo * tau * returns).min(absorb).min(cap)
+}
+
+/// Predicts the collisions a run of `cfg` over `n_dirs` incident directions takes.
+pub fn estimate_work(slab: &Slab, cfg: &SimConfig, n_dirs: usize) -> Work {
+    let reps = slab.distinct_channels();
+    let channels = (0..3).filter(|&c| reps[c] == c).count() as f64;
+    let per_walk = (0..3)
+        .filter(|&c| reps[c] == c)
+        .map(|c| collisions_per_walk(slab.medium(c), slab.d, slab.sheet.front.eta.max(slab.sheet.back.eta)))
+        .fold(0.0, f64::max);
+    let nb = cfg.batches.max(1) as u64;
+    let first = cfg.samples.div_ceil(nb).max(1) * nb;
+    let walks = first as f64 * channels * n_dirs as f64;
+    let max_walks = match cfg.rel_stderr {
+        Some(_) => cfg.max_samples.max(first) as f64 * channels * n_dirs as f64,
+        None => walks,
+    };
+    Work {
+        collisions_per_walk: per_walk,
+        walks,
+        collisions: walks * per_walk,
+        max_collisions: max_walks * per_walk,
+    }
+}
+
+/// Measures this machine's collision rate (collisions per second over all
+/// cores) on `slab` lit from `wi`, with walks of a separate generator for
+/// about `seconds` (a pilot for time estimates; it changes no result).
+pub fn measure_collision_rate(slab: &Slab, wi: DVec3, wos: &[DVec3], seconds: f64) -> f64 {
+    let start = std::time::Instant::now();
+    let mut rng = Pcg64Mcg::seed_from_u64(0x9170_7000);
+    let tracer = Tracer::new(slab, 0, wos);
+    let mut tally = Tally::new(wos.len());
+    let mut collisions = 0u64;
+    while start.elapsed().as_secs_f64() < seconds {
+        tally.clear();
+        tracer.walk(wi, &mut rng, &mut tally);
+        collisions += tally.collisions.max(1);
+    }
+    collisions as f64 / start.elapsed().as_secs_f64().max(1e-9) * rayon::current_num_threads() as f64
 }

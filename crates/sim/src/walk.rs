@@ -90,6 +90,13 @@ use std::f64::consts::PI;
 
 /// Weight below which Russian roulette is played.
 const RR_THRESHOLD: f64 = 0.01;
+
+/// Scattering events after which a walk is cut (counted in [`Tally::truncated`]).
+/// A walk in a nearly conservative slab of optical thickness `tau` takes about
+/// `tau^2` collisions to cross it, so this cuts nothing below `tau` of about
+/// 3000, far beyond paper (`tau` of 10 to 100); it bounds the work of absurd
+/// inputs (`sigma_s = 1e308`), whose walks have a heavy-tailed length.
+pub const MAX_COLLISIONS_PER_WALK: usize = 10_000_000;
 /// Next-event contributions whose bound is below this are subject to Russian
 /// roulette (played with survival probability bound / NEE_RR_SCALE): deep
 /// vertices seen through many mean free paths cost almost nothing.
@@ -168,6 +175,9 @@ pub struct Tally {
     pub t: f64,
     /// Number of scattering events (collisions with scattering) in the walk(s).
     pub collisions: u64,
+    /// Walks cut at [`MAX_COLLISIONS_PER_WALK`] (their remaining flux, at most
+    /// their weight of 1 each, is missing from every estimate).
+    pub truncated: u64,
     /// When `Some`, the contributions to `f` split by the number of volume
     /// scattering events on the path: `[0, 1, 2 or more]` per viewing direction
     /// (0: surface reflection and unscattered light, including internal
@@ -185,6 +195,7 @@ impl Tally {
             r: 0.0,
             t: 0.0,
             collisions: 0,
+            truncated: 0,
             by_order: None,
             order: 0,
         }
@@ -197,6 +208,7 @@ impl Tally {
         self.r += o.r;
         self.t += o.t;
         self.collisions += o.collisions;
+        self.truncated += o.truncated;
         if let (Some(a), Some(b)) = (self.by_order.as_mut(), o.by_order.as_ref()) {
             for (x, y) in a.iter_mut().zip(b) {
                 for k in 0..3 {
@@ -223,6 +235,7 @@ impl Tally {
         self.r = 0.0;
         self.t = 0.0;
         self.collisions = 0;
+        self.truncated = 0;
         self.order = 0;
     }
 
@@ -710,6 +723,10 @@ impl<'a> Tracer<'a> {
                 }
                 tally.collisions += 1;
                 tally.order += 1;
+                if tally.order >= MAX_COLLISIONS_PER_WALK {
+                    tally.truncated += 1;
+                    return;
+                }
                 let v = Vertex::Volume { z, prev: dir };
                 self.nee_exit(v, weight, rng, tally);
                 for &(wl, g) in &self.delta_lobes {

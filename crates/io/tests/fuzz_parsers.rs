@@ -1,0 +1,247 @@
+//! Property-based fuzzing (proptest) of the io crate's parsers: parameter
+//! files (JSON and TOML), direction CSVs and angle lists. Arbitrary bytes and
+//! structured near-valid inputs must give `Ok` or an error naming the origin,
+//! never a panic, and never a large allocation (a counting allocator records
+//! the largest single request; inputs are at most a few kB, so any request
+//! above 16 MiB is unbounded growth).
+//!
+//! Case counts are chosen so the whole file runs in a few seconds on 2 cores.
+
+use paperbsdf_core::PaperParams;
+use paperbsdf_io::angles::parse_angles;
+use paperbsdf_io::dirs::parse_dirs;
+use paperbsdf_io::params::parse_text;
+use proptest::prelude::*;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Largest;
+static LARGEST: AtomicUsize = AtomicUsize::new(0);
+unsafe impl GlobalAlloc for Largest {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        LARGEST.fetch_max(l.size(), Ordering::Relaxed);
+        System.alloc(l)
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        System.dealloc(p, l)
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
+        LARGEST.fetch_max(n, Ordering::Relaxed);
+        System.realloc(p, l, n)
+    }
+}
+#[global_allocator]
+static A: Largest = Largest;
+
+const ALLOC_LIMIT: usize = 16 << 20;
+
+fn bounded() {
+    let m = LARGEST.load(Ordering::Relaxed);
+    assert!(m < ALLOC_LIMIT, "an allocation of {m} bytes");
+}
+
+/// A text that is mostly valid: fragments of the format mixed with noise.
+fn mixed_text(fragments: &'static [&'static str]) -> impl Strategy<Value = String> {
+    prop::collection::vec(
+        prop_oneof![
+            3 => prop::sample::select(fragments).prop_map(str::to_string),
+            1 => "[ -~\\n\\t\u{feff}\u{e9}]{0,8}",
+            1 => prop::num::f64::ANY.prop_map(|x| x.to_string()),
+        ],
+        0..40,
+    )
+    .prop_map(|v| v.concat())
+}
+
+const JSON_BITS: &[&str] = &[
+    "{",
+    "}",
+    "[",
+    "]",
+    ",",
+    ":",
+    "\"d\"",
+    "\"sigma_a\"",
+    "\"sigma_s\"",
+    "\"g_f\"",
+    "\"g_b\"",
+    "\"w_b\"",
+    "\"eta_f\"",
+    "\"eta_b\"",
+    "\"m_f\"",
+    "\"m_b\"",
+    "\"dist_f\"",
+    "\"dist_b\"",
+    "\"ggx\"",
+    "\"beckmann\"",
+    "0.1",
+    "1e308",
+    "-1",
+    "[1,2,3]",
+    "[1,2]",
+    "null",
+    "true",
+    "\"",
+    "\\",
+    "\u{feff}",
+];
+const TOML_BITS: &[&str] = &[
+    "d",
+    "sigma_a",
+    "sigma_s",
+    "g_f",
+    "w_b",
+    "eta_f",
+    "m_b",
+    "dist_f",
+    " = ",
+    "\n",
+    "\"ggx\"",
+    "0.3",
+    "[1, 2, 3]",
+    "[",
+    "]",
+    "[table]",
+    "inf",
+    "nan",
+    "'",
+    "\"",
+    "#",
+    "\u{feff}",
+];
+const CSV_BITS: &[&str] = &[
+    "wi_x",
+    "wi_y",
+    "wi_z",
+    "wo_x",
+    "wo_y",
+    "wo_z",
+    "id",
+    ",",
+    "\n",
+    "\r\n",
+    "#",
+    "0",
+    "1",
+    "-1",
+    "0.7071067811865476",
+    "nan",
+    "inf",
+    "1e400",
+    " ",
+    "\u{feff}",
+];
+const GOOD: &str = r#"{"d":0.1,"sigma_a":0.6,"sigma_s":[120,110,100],"g_f":0.85,"g_b":-0.4,"w_b":0.15,"eta_f":1.45,"eta_b":1.45,"m_f":0.35,"m_b":0.35,"dist_f":"ggx","dist_b":"ggx"}"#;
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 400, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn params_from_arbitrary_bytes(bytes in prop::collection::vec(any::<u8>(), 0..512), toml in any::<bool>()) {
+        let text = String::from_utf8_lossy(&bytes);
+        let _ = parse_text::<PaperParams>(&text, "fuzz", toml).map_err(|e| assert!(e.to_string().starts_with("fuzz:"), "{e}"));
+        bounded();
+    }
+
+    #[test]
+    fn params_from_near_valid_json(text in mixed_text(JSON_BITS)) {
+        match parse_text::<PaperParams>(&text, "fuzz.json", false) {
+            Ok(p) => { let _ = p.validate(); }
+            Err(e) => assert!(e.to_string().starts_with("fuzz.json:"), "{e}"),
+        }
+        bounded();
+    }
+
+    #[test]
+    fn params_from_near_valid_toml(text in mixed_text(TOML_BITS)) {
+        match parse_text::<PaperParams>(&text, "fuzz.toml", true) {
+            Ok(p) => { let _ = p.validate(); }
+            Err(e) => assert!(e.to_string().starts_with("fuzz.toml:"), "{e}"),
+        }
+        bounded();
+    }
+
+    /// Structured values: every parameter replaced by an arbitrary number
+    /// (including non-finite ones and out-of-range values) or a wrong type.
+    #[test]
+    fn params_with_arbitrary_values(key in prop::sample::select(&["d","sigma_a","sigma_s","g_f","g_b","w_b","eta_f","eta_b","m_f","m_b","dist_f","dist_b"][..]),
+                                    value in prop_oneof![
+                                        prop::num::f64::ANY.prop_map(|x| format!("{x:e}")),
+                                        prop::collection::vec(prop::num::f64::NORMAL, 0..5).prop_map(|v| format!("{v:?}")),
+                                        "\"[a-z]{0,6}\"",
+                                        Just("null".to_string()),
+                                        Just("{}".to_string()),
+                                    ]) {
+        let v: serde_json::Value = serde_json::from_str(GOOD).unwrap();
+        let mut m = v.as_object().unwrap().clone();
+        let text = match serde_json::from_str::<serde_json::Value>(&value) {
+            Ok(x) => { m.insert(key.to_string(), x); serde_json::to_string(&m).unwrap() }
+            // Not JSON (e.g. `inf`): splice the text in as written.
+            Err(_) => GOOD.replacen(&format!("\"{key}\":"), &format!("\"{key}\":{value},\"x_{key}\":"), 1),
+        };
+        match parse_text::<PaperParams>(&text, "<inline>", false) {
+            Ok(p) => {
+                if let Err(e) = p.validate() {
+                    assert!(!e.name().is_empty(), "a range error names its parameter");
+                }
+            }
+            Err(e) => assert!(e.to_string().starts_with("<inline>:"), "{e}"),
+        }
+        bounded();
+    }
+
+    #[test]
+    fn dirs_from_arbitrary_bytes(bytes in prop::collection::vec(any::<u8>(), 0..512)) {
+        let text = String::from_utf8_lossy(&bytes);
+        if let Err(e) = parse_dirs(&text, "fuzz.csv") {
+            assert!(e.to_string().starts_with("fuzz.csv"), "{e}");
+        }
+        bounded();
+    }
+
+    #[test]
+    fn dirs_from_near_valid_csv(text in mixed_text(CSV_BITS)) {
+        match parse_dirs(&text, "fuzz.csv") {
+            Ok(f) => for r in &f.rows {
+                // Whatever was accepted is a pair of finite unit vectors.
+                assert!(r.wi.is_finite() && r.wo.is_finite());
+                assert!((r.wi.length() - 1.0).abs() < 1e-9 && (r.wo.length() - 1.0).abs() < 1e-9);
+            },
+            Err(e) => assert!(e.to_string().starts_with("fuzz.csv"), "{e}"),
+        }
+        bounded();
+    }
+
+    /// Structured rows: arbitrary numbers in a valid header layout.
+    #[test]
+    fn dirs_with_arbitrary_numbers(rows in prop::collection::vec(prop::array::uniform6(prop::num::f64::ANY), 0..20)) {
+        let mut text = String::from("wi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n");
+        for r in &rows {
+            text.push_str(&r.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(","));
+            text.push('\n');
+        }
+        match parse_dirs(&text, "fuzz.csv") {
+            Ok(f) => assert_eq!(f.rows.len(), rows.len()),
+            Err(e) => assert!(e.to_string().contains("fuzz.csv:"), "{e}"),
+        }
+        bounded();
+    }
+
+    /// Angle lists: arbitrary text and arbitrary FROM:TO:STEP numbers; the
+    /// result is never longer than the limit, and every angle is finite.
+    #[test]
+    fn angle_lists(text in "[-0-9.:e a-z]{0,24}",
+                   from in prop::num::f64::ANY, to in prop::num::f64::ANY, step in prop::num::f64::ANY,
+                   limit in 1usize..5000) {
+        for s in [text.clone(), format!("{from}:{to}:{step}"), format!("{from:e}:{to:e}:{step:e}")] {
+            match parse_angles(&s, "--theta-o", limit) {
+                Ok(v) => {
+                    assert!(!v.is_empty() && v.len() <= limit, "{s}: {} angles", v.len());
+                    assert!(v.iter().all(|a| a.is_finite()), "{s}");
+                }
+                Err(e) => assert!(e.0.contains(&format!("`{s}`")), "the error quotes the input: {}", e.0),
+            }
+        }
+        bounded();
+    }
+}
