@@ -20,8 +20,10 @@
 #![warn(missing_docs)]
 
 pub mod estimate;
+pub mod lateral;
 pub mod slab;
 pub mod walk;
 
 pub use estimate::{simulate_bsdf, simulate_totals, BsdfRun, Estimate, Incidence, SimConfig, SimError, Totals};
+pub use lateral::{simulate_exit_profile, ExitProfile, LateralConfig};
 pub use slab::{Face, Medium, Slab};
