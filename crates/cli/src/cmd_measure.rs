@@ -324,7 +324,9 @@ pub fn run_datasheet(a: DatasheetArgs) -> Result<()> {
     let fit = match fit_datasheet(&ds) {
         Ok(f) => f,
         Err(DatasheetError::BadInput(m)) => bail!("{m}"),
-        Err(DatasheetError::Impossible(m)) => bail!("no sheet can meet this datasheet: {m}"),
+        Err(DatasheetError::Impossible(m) | DatasheetError::Unreachable(m)) => {
+            bail!("no sheet can meet this datasheet: {m}")
+        }
     };
     let text = serde_json::to_string_pretty(&fit.params)?;
     paperbsdf_io::write_atomic(&a.out, format!("{text}\n").as_bytes())?;

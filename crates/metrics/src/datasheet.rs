@@ -41,7 +41,7 @@ pub const SIGMA_S_RANGE: (f64, f64) = (0.5, 10_000.0);
 /// Range searched for `sigma_a`, 1/mm.
 pub const SIGMA_A_RANGE: (f64, f64) = (1e-7, 500.0);
 /// Range searched for `m_f`.
-pub const M_F_RANGE: (f64, f64) = (0.003, 1.2);
+pub const M_F_RANGE: (f64, f64) = (0.01, 1.2);
 /// Density of solid cellulose, g/cm^3: no sheet is denser.
 pub const MAX_DENSITY: f64 = 1.6;
 
@@ -71,6 +71,10 @@ pub enum DatasheetError {
     /// Targets that no sheet of this kind can meet, with the reason.
     #[error("{0}")]
     Impossible(String),
+    /// The pad reflectance cannot be reached at one trial `sigma_s` (internal
+    /// to the search: more scattering may reach it).
+    #[error("{0}")]
+    Unreachable(String),
 }
 
 impl Datasheet {
@@ -237,6 +241,7 @@ pub fn fit_datasheet(ds: &Datasheet) -> Result<DatasheetFit, DatasheetError> {
     let q = Quality::fast();
     let d = ds.caliper;
     let ln = f64::ln;
+    let channel = ["red", "green", "blue"];
 
     // Solve m_f for the gloss with the body `ss`, `sa`.
     let solve_gloss = |ss: f64, sa: [f64; 3], target: f64| -> Result<f64, DatasheetError> {
@@ -255,7 +260,7 @@ pub fn fit_datasheet(ds: &Datasheet) -> Result<DatasheetFit, DatasheetError> {
             )));
         }
         // Gloss decreases with m: solve in -ln m so the function increases.
-        let mut err = None;
+        let err = std::cell::RefCell::new(None);
         let x = illinois(
             (-ln(M_F_RANGE.1), glo - target),
             (-ln(M_F_RANGE.0), ghi - target),
@@ -263,146 +268,203 @@ pub fn fit_datasheet(ds: &Datasheet) -> Result<DatasheetFit, DatasheetError> {
             |x| match g_at((-x).exp()) {
                 Ok(v) => v - target,
                 Err(e) => {
-                    err = Some(e);
-                    0.0
-                }
-            },
-        );
-        match err {
-            Some(e) => Err(e),
-            None => Ok((-x).exp()),
-        }
-    };
-
-    // For a sigma_s, the sigma_a of each channel that gives target_rinf; returns them and the opacity.
-    let solve_absorption = |ss: f64, m: f64, warm: [f64; 3]| -> Result<([f64; 3], f64), DatasheetError> {
-        let eval = |sa: [f64; 3]| body(&params(d, ss, sa, m, dist_f), &q);
-        let (rmax, _) = eval([SIGMA_A_RANGE.0; 3])?;
-        for c in 0..3 {
-            if target_rinf[c] > rmax[c] + 5e-4 {
-                return Err(DatasheetError::Impossible(format!(
-                    "pad reflectance {:.1} % in the {} channel (brightness {brightness} %{}): a non-absorbing sheet with these faces reflects at most {:.1} %; more needs fluorescent whitening (or faces that lose less light)",
-                    100.0 * target_rinf[c],
-                    ["red", "green", "blue"][c],
-                    if ds.tint.is_some() { " with the tint" } else { "" },
-                    100.0 * rmax[c]
-                )));
-            }
-        }
-        // Illinois on each channel at once, in u = ln sigma_a (R_inf decreases with u: use -R).
-        let mut lo = [(ln(SIGMA_A_RANGE.0), 0.0); 3];
-        let mut hi = [(ln(SIGMA_A_RANGE.1), 0.0); 3];
-        let (rlo, _) = (rmax, 0.0);
-        let (rhi, _) = eval([SIGMA_A_RANGE.1; 3])?;
-        for c in 0..3 {
-            lo[c].1 = target_rinf[c] - rlo[c];
-            hi[c].1 = target_rinf[c] - rhi[c];
-            // Warm start: tighten the bracket around the previous solution if it brackets.
-            let _ = warm;
-        }
-        let mut x = [0.0; 3];
-        let mut side = [0i32; 3];
-        let mut done = [false; 3];
-        for c in 0..3 {
-            if hi[c].1 <= 0.0 {
-                // Even the most absorbing sheet is brighter than asked (target below the faces' reflection).
-                return Err(DatasheetError::Impossible(format!(
-                    "pad reflectance {:.1} % in the {} channel is below what the faces alone reflect ({:.1} %)",
-                    100.0 * target_rinf[c],
-                    ["red", "green", "blue"][c],
-                    100.0 * rhi[c]
-                )));
-            }
-        }
-        let mut last = (rmax, 0.0);
-        for _ in 0..60 {
-            for c in 0..3 {
-                if !done[c] {
-                    x[c] = if hi[c].1 != lo[c].1 {
-                        (lo[c].0 * hi[c].1 - hi[c].0 * lo[c].1) / (hi[c].1 - lo[c].1)
-                    } else {
-                        0.5 * (lo[c].0 + hi[c].0)
-                    };
-                }
-            }
-            let sa = [x[0].exp(), x[1].exp(), x[2].exp()];
-            last = eval(sa)?;
-            let mut all = true;
-            for c in 0..3 {
-                let v = target_rinf[c] - last.0[c];
-                if v.abs() < 2e-5 || (hi[c].0 - lo[c].0).abs() < 1e-10 {
-                    done[c] = true;
-                    continue;
-                }
-                done[c] = false;
-                all = false;
-                if v < 0.0 {
-                    lo[c] = (x[c], v);
-                    if side[c] == -1 {
-                        hi[c].1 *= 0.5;
-                    }
-                    side[c] = -1;
-                } else {
-                    hi[c] = (x[c], v);
-                    if side[c] == 1 {
-                        lo[c].1 *= 0.5;
-                    }
-                    side[c] = 1;
-                }
-            }
-            if all {
-                return Ok((sa, last.1));
-            }
-        }
-        Ok(([x[0].exp(), x[1].exp(), x[2].exp()], last.1))
-    };
-
-    // Round 1: gloss with a typical body; then the body; then the gloss again.
-    let mut ss = 300.0;
-    let mut sa = [0.1; 3];
-    if let Some(g) = ds.gloss75 {
-        m_f = solve_gloss(ss, sa, g)?;
-    }
-    let target_op = ds.opacity;
-    for round in 0..2 {
-        let (l0, l1) = (ln(SIGMA_S_RANGE.0), ln(SIGMA_S_RANGE.1));
-        let (_, op_lo) = solve_absorption(l0.exp(), m_f, sa)?;
-        let (_, op_hi) = solve_absorption(l1.exp(), m_f, sa)?;
-        if target_op > op_hi + 0.02 {
-            return Err(DatasheetError::Impossible(format!(
-                "opacity {target_op} %: at caliper {d} mm even sigma_s = {} /mm (the most scattering searched) gives {op_hi:.1} % with this brightness; a thicker sheet or a darker one is needed",
-                SIGMA_S_RANGE.1
-            )));
-        }
-        if target_op < op_lo - 0.02 {
-            return Err(DatasheetError::Impossible(format!(
-                "opacity {target_op} %: at caliper {d} mm even sigma_s = {} /mm gives {op_lo:.1} % with this brightness (the faces' own reflection and the absorption that the brightness needs make the sheet that opaque)",
-                SIGMA_S_RANGE.0
-            )));
-        }
-        let err = std::cell::RefCell::new(None);
-        let lss = illinois(
-            (l0, op_lo - target_op),
-            (l1, op_hi - target_op),
-            0.01,
-            |x| match solve_absorption(x.exp(), m_f, sa) {
-                Ok((_, op)) => op - target_op,
-                Err(e) => {
                     *err.borrow_mut() = Some(e);
                     0.0
                 }
             },
         );
+        match err.into_inner() {
+            Some(e) => Err(e),
+            None => Ok((-x).exp()),
+        }
+    };
+
+    // For a sigma_s, the sigma_a of each channel that gives the pad
+    // reflectance `trinf` (safeguarded secant in ln sigma_a, all channels at
+    // once, started from `guess`); returns them and the opacity.
+    let solve_absorption = |ss: f64,
+                            m: f64,
+                            guess: [f64; 3],
+                            trinf: [f64; 3]|
+     -> Result<([f64; 3], f64), DatasheetError> {
+        let eval = |x: [f64; 3]| body(&params(d, ss, [x[0].exp(), x[1].exp(), x[2].exp()], m, dist_f), &q);
+        let (xa, xb) = (ln(SIGMA_A_RANGE.0), ln(SIGMA_A_RANGE.1));
+        // v(x) = trinf - R_inf(x) increases with x (more absorption, darker pad).
+        let mut lo: [Option<(f64, f64)>; 3] = [None; 3];
+        let mut hi: [Option<(f64, f64)>; 3] = [None; 3];
+        let mut x: [f64; 3] = std::array::from_fn(|c| ln(guess[c].clamp(SIGMA_A_RANGE.0, SIGMA_A_RANGE.1)));
+        let mut prev: [Option<(f64, f64)>; 3] = [None; 3];
+        let mut last_op = 0.0;
+        for it in 0..40 {
+            let (r, op) = eval(x)?;
+            last_op = op;
+            let mut done = true;
+            let mut need_min = false;
+            let mut next = x;
+            for c in 0..3 {
+                let v = trinf[c] - r[c];
+                if v.abs() < 1e-5 {
+                    continue;
+                }
+                done = false;
+                if v < 0.0 {
+                    lo[c] = Some((x[c], v));
+                } else {
+                    hi[c] = Some((x[c], v));
+                    if lo[c].is_none() {
+                        need_min = true;
+                    }
+                }
+                // Secant through the last two points, kept inside the bracket.
+                let (blo, bhi) = (lo[c].map_or(xa, |p| p.0), hi[c].map_or(xb, |p| p.0));
+                let mut xn = match prev[c] {
+                    Some((xp, vp)) if vp != v => x[c] - v * (x[c] - xp) / (v - vp),
+                    _ => x[c] - v.signum() * 0.7,
+                };
+                if !(xn > blo && xn < bhi && xn.is_finite()) {
+                    xn = match (lo[c], hi[c]) {
+                        (Some(l), Some(h)) => 0.5 * (l.0 + h.0),
+                        (None, _) => (x[c] - 2.0).max(xa),
+                        (_, None) => (x[c] + 2.0).min(xb),
+                    };
+                }
+                prev[c] = Some((x[c], v));
+                next[c] = xn;
+            }
+            if done {
+                return Ok(([x[0].exp(), x[1].exp(), x[2].exp()], op));
+            }
+            if need_min && it == 0 {
+                // Can the pad reach the target at all (no absorption)?
+                let (rmax, _) = eval([xa; 3])?;
+                for c in 0..3 {
+                    if trinf[c] > rmax[c] + 5e-4 {
+                        return Err(DatasheetError::Unreachable(format!(
+                            "pad reflectance {:.1} % in the {} channel (brightness {brightness} %{}): a non-absorbing sheet with these faces reflects at most {:.1} %; more needs fluorescent whitening (or faces that lose less light)",
+                            100.0 * trinf[c],
+                            channel[c],
+                            if ds.tint.is_some() { " with the tint" } else { "" },
+                            100.0 * rmax[c]
+                        )));
+                    }
+                }
+            }
+            x = next;
+        }
+        Ok(([x[0].exp(), x[1].exp(), x[2].exp()], last_op))
+    };
+
+    // The body for targets (opacity, pad reflectance) at front roughness m:
+    // Illinois on ln sigma_s; a sigma_s at which the pad reflectance cannot
+    // be reached counts as too little scattering.
+    let solve_body = |m: f64,
+                      t_op: f64,
+                      trinf: [f64; 3],
+                      start: (f64, [f64; 3])|
+     -> Result<(f64, [f64; 3]), DatasheetError> {
+        let unreachable = std::cell::RefCell::new(None);
+        let warm = std::cell::Cell::new(start);
+        let op_minus = |x: f64| -> Result<f64, DatasheetError> {
+            let (ss0, sa0) = warm.get();
+            // Absorption scales with scattering at a fixed pad reflectance (K/S).
+            let k = x.exp() / ss0;
+            let guess = [sa0[0] * k, sa0[1] * k, sa0[2] * k];
+            match solve_absorption(x.exp(), m, guess, trinf) {
+                Ok((sa, op)) => {
+                    warm.set((x.exp(), sa));
+                    Ok(op - t_op)
+                }
+                Err(DatasheetError::Unreachable(msg)) => {
+                    *unreachable.borrow_mut() = Some(msg);
+                    Ok(-1000.0)
+                }
+                Err(e) => Err(e),
+            }
+        };
+        let (l0, l1) = (ln(SIGMA_S_RANGE.0), ln(SIGMA_S_RANGE.1));
+        // A first try at the start, a bracket from the range's ends only if needed.
+        let x_s = ln(start.0);
+        let g_s = op_minus(x_s)?;
+        if g_s.abs() < 0.01 {
+            return Ok(warm.get());
+        }
+        let (lo, hi) = if g_s < 0.0 {
+            let g_hi = op_minus(l1)?;
+            if g_hi == -1000.0 {
+                let why = unreachable.borrow().clone().unwrap_or_default();
+                return Err(DatasheetError::Impossible(format!(
+                    "{why} (even at sigma_s = {} /mm, the most scattering searched)",
+                    SIGMA_S_RANGE.1
+                )));
+            }
+            if g_hi < -0.02 {
+                return Err(DatasheetError::Impossible(format!(
+                    "opacity {t_op:.1} %: at caliper {d} mm even sigma_s = {} /mm (the most scattering searched) gives {:.1} % with this brightness; a thicker sheet or a darker one is needed",
+                    SIGMA_S_RANGE.1,
+                    t_op + g_hi
+                )));
+            }
+            ((x_s, g_s), (l1, g_hi))
+        } else {
+            let g_lo = op_minus(l0)?;
+            if g_lo > 0.02 {
+                return Err(DatasheetError::Impossible(format!(
+                    "opacity {t_op:.1} %: at caliper {d} mm even sigma_s = {} /mm gives {:.1} % with this brightness (the faces' own reflection and the absorption that the brightness needs make the sheet that opaque)",
+                    SIGMA_S_RANGE.0,
+                    t_op + g_lo
+                )));
+            }
+            ((l0, g_lo), (x_s, g_s))
+        };
+        let err = std::cell::RefCell::new(None);
+        let x = illinois(lo, hi, 0.01, |x| match op_minus(x) {
+            Ok(v) => v,
+            Err(e) => {
+                *err.borrow_mut() = Some(e);
+                0.0
+            }
+        });
         if let Some(e) = err.into_inner() {
             return Err(e);
         }
-        ss = lss.exp();
-        sa = solve_absorption(ss, m_f, sa)?.0;
-        match ds.gloss75 {
-            Some(g) if round == 0 => m_f = solve_gloss(ss, sa, g)?,
-            _ => break,
+        let g = op_minus(x)?;
+        if g.abs() > 0.05 {
+            // The search ended at the edge of the reachable range: the least
+            // scattering that reaches the brightness is already too opaque.
+            return Err(DatasheetError::Impossible(format!(
+                "opacity {t_op:.1} % with brightness {brightness} % at caliper {d} mm: the least scattering sheet that reflects that much (sigma_s = {:.3} /mm) already has opacity {:.1} %",
+                x.exp(),
+                t_op + g.max(0.0)
+            )));
         }
+        Ok(warm.get())
+    };
+
+    // Gloss with a typical body, the body, the gloss again; then a correction
+    // for the difference between the fast integrals of the search and the
+    // default ones that `measure` uses (the targets are shifted by it and
+    // the body solved again from where it was).
+    let mut body_now = (300.0, [0.05; 3]);
+    if let Some(g) = ds.gloss75 {
+        m_f = solve_gloss(body_now.0, body_now.1, g)?;
     }
+    let (mut t_op, mut t_rinf) = (ds.opacity, target_rinf);
+    for pass in 0..3 {
+        body_now = solve_body(m_f, t_op, t_rinf, body_now)?;
+        if let (Some(g), 0) = (ds.gloss75, pass) {
+            m_f = solve_gloss(body_now.0, body_now.1, g)?;
+            body_now = solve_body(m_f, t_op, t_rinf, body_now)?;
+        }
+        let p = params(d, body_now.0, body_now.1, m_f, dist_f);
+        let (rf, of) = body(&p, &q)?;
+        let (rd, od) = body(&p, &Quality::default())?;
+        if (od - ds.opacity).abs() < 0.05 && (0..3).all(|c| (rd[c] - target_rinf[c]).abs() < 5e-4) {
+            break;
+        }
+        t_op = ds.opacity - (od - of);
+        t_rinf = std::array::from_fn(|c| target_rinf[c] - (rd[c] - rf[c]));
+    }
+    let (ss, sa) = body_now;
     let p = params(d, ss, sa, m_f, dist_f);
     let model = PaperBsdf::new(&p).map_err(|e| DatasheetError::BadInput(e.to_string()))?;
     let sel = Selection::parse("opacity_iso2471,r457,gloss_75_tappi_t480,kubelka_munk").expect("known names");

@@ -231,10 +231,8 @@ pub fn sheet_multipoles(p: &PaperParams) -> Option<[Multipole; 3]> {
     let (rf, rb) = (rho(p.dist_f, p.eta_f, p.m_f)?, rho(p.dist_b, p.eta_b, p.m_b)?);
     let g = p.w_b * p.g_b + (1.0 - p.w_b) * p.g_f;
     let (sa, ss) = (p.sigma_a.rgb(), p.sigma_s.rgb());
-    let mut out = [None; 3];
-    for c in 0..3 {
-        out[c] = Multipole::new((1.0 - g) * ss.0[c], sa.0[c], p.d, rf, rb);
-    }
+    let out: [Option<Multipole>; 3] =
+        std::array::from_fn(|c| Multipole::new((1.0 - g) * ss.0[c], sa.0[c], p.d, rf, rb));
     Some([out[0]?, out[1]?, out[2]?])
 }
 

@@ -123,18 +123,19 @@ fn window_points(w: Window, n: usize) -> Vec<(f64, f64, f64)> {
     match w {
         Window::Rect(ia, ib) => {
             let (ha, hb) = (ia.to_radians() / 2.0, ib.to_radians() / 2.0);
-            // Composite rule: 3 panels per axis of n nodes (sharp lobes near the edges).
-            let panels = 3;
-            let node = |h: f64, p: usize, k: usize| -> (f64, f64) {
+            // Composite rule: 6 panels in plane and 5 across of n nodes each,
+            // so that a lobe of a fraction of a degree (m ~ 0.01) is resolved.
+            let (pan_a, pan_b) = (6, 5);
+            let node = |h: f64, panels: usize, p: usize, k: usize| -> (f64, f64) {
                 let w = 2.0 * h / panels as f64;
                 (-h + (p as f64 + x[k]) * w, wx[k] * w)
             };
-            for pa in 0..panels {
+            for pa in 0..pan_a {
                 for ka in 0..n {
-                    let (a, wa) = node(ha, pa, ka);
-                    for pb in 0..panels {
+                    let (a, wa) = node(ha, pan_a, pa, ka);
+                    for pb in 0..pan_b {
                         for kb in 0..n {
-                            let (b, wb) = node(hb, pb, kb);
+                            let (b, wb) = node(hb, pan_b, pb, kb);
                             pts.push((a, b, wa * wb * b.cos()));
                         }
                     }

@@ -163,11 +163,11 @@ pub fn simulate_pad(
             e.stderr.0[c] = (var / n).sqrt();
         }
     }
-    for c in 0..3 {
-        if reps[c] != c {
+    for (c, &rc) in reps.iter().enumerate() {
+        if rc != c {
             for e in est.iter_mut() {
-                e.mean.0[c] = e.mean.0[reps[c]];
-                e.stderr.0[c] = e.stderr.0[reps[c]];
+                e.mean.0[c] = e.mean.0[rc];
+                e.stderr.0[c] = e.stderr.0[rc];
             }
         }
     }

@@ -184,7 +184,9 @@ fn kubelka_munk_inverts_the_forward_formulas() {
 #[test]
 fn stacking_limits() {
     // A non-absorbing sheet (R + T = 1): the pad reflects everything.
-    assert!((instrument::pad_reflectance(0.3, 0.3, 0.7) - 1.0).abs() < 1e-9);
+    // (The discriminant vanishes there: its rounding, ~1e-16, enters through a
+    // square root, so the limit is exact only to ~1e-8.)
+    assert!((instrument::pad_reflectance(0.3, 0.3, 0.7) - 1.0).abs() < 1e-7);
     // A black sheet: the pad is the sheet.
     assert!((instrument::pad_reflectance(0.2, 0.2, 0.0) - 0.2).abs() < 1e-12);
     // The closed form is the limit of the recursion, with unequal faces too.
@@ -197,10 +199,13 @@ fn stacking_limits() {
 
 #[test]
 fn multipole_profile_integrates_to_rd() {
+    // Absorbing slabs: with sigma_a = 0 the pairs' sum and the integral over
+    // the plane do not commute (each pair alone integrates to +-1), and only
+    // the resummed closed form is right.
     for &(ssp, sa, d, rf, rb) in &[
         (120.0, 0.1, 0.1, 0.55, 0.55),
         (30.0, 2.0, 0.25, 0.4, 0.6),
-        (300.0, 0.0, 0.05, 0.5, 0.3),
+        (300.0, 0.05, 0.05, 0.5, 0.3),
     ] {
         let m = Multipole::new(ssp, sa, d, rf, rb).unwrap();
         let (rd, _) = m.rd_td();

@@ -107,7 +107,7 @@ pub fn simulate_exit_profile(slab: &Slab, wi: DVec3, cfg: &LateralConfig) -> Res
             message: "need at least 2 batches and one walk",
         });
     }
-    if !(cfg.half_width > 0.0 && cfg.half_width.is_finite()) || cfg.bins < 3 || cfg.bins % 2 == 0 {
+    if !(cfg.half_width > 0.0 && cfg.half_width.is_finite()) || cfg.bins < 3 || cfg.bins.is_multiple_of(2) {
         return Err(SimError::BadConfig {
             name: "bins",
             value: cfg.bins as f64,
