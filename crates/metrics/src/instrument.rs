@@ -208,6 +208,8 @@ pub struct Reflectances {
     pub r0_15: [f64; 3],
     /// `15/d` reflectance of one sheet over a white backing of 89 % (TAPPI T425 `R0.89`).
     pub r089_15: [f64; 3],
+    /// `d/0` transmittance factor of one sheet (decides the opacity of a sheet that reflects nothing).
+    pub t0: [f64; 3],
 }
 
 /// Reflectance of the TAPPI T425 white backing.
@@ -220,6 +222,7 @@ pub fn stack(f: &SheetFactors) -> Reflectances {
         r_inf: [0.0; 3],
         r0_15: f.r_15,
         r089_15: [0.0; 3],
+        t0: f.t_d0,
     };
     for c in 0..3 {
         let (rf, rb, t) = (f.r_hh_front[c], f.r_hh_back[c], f.t_hh[c]);

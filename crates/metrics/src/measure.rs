@@ -134,12 +134,15 @@ impl Measurements {
     fn set_reflectances(&mut self, r: Reflectances, grammage: Option<f64>, sel: &Selection) {
         let y = |v: [f64; 3]| luminance(Rgb(v));
         let (r0, rinf) = (y(r.r0), y(r.r_inf));
+        // A sheet that reflects nothing has no contrast ratio: its opacity is
+        // taken as the limit 100 (1 - Y(T0)), 0 for a clear sheet, 100 for a black one.
+        let none = 100.0 * (1.0 - y(r.t0)).clamp(0.0, 1.0);
         if sel.has("opacity_iso2471") {
-            self.opacity_iso2471 = Some(if rinf > 0.0 { 100.0 * r0 / rinf } else { 100.0 });
+            self.opacity_iso2471 = Some(if rinf > 0.0 { 100.0 * r0 / rinf } else { none });
         }
         if sel.has("opacity_tappi_t425") {
             let r89 = y(r.r089_15);
-            self.opacity_tappi_t425 = Some(if r89 > 0.0 { 100.0 * y(r.r0_15) / r89 } else { 100.0 });
+            self.opacity_tappi_t425 = Some(if r89 > 0.0 { 100.0 * y(r.r0_15) / r89 } else { none });
         }
         if sel.has("r457") {
             self.r457 = Some(100.0 * r.r_inf[2]);
@@ -293,6 +296,7 @@ pub fn measure_truth(
             r_inf: pad.reflected_trapped.mean.0,
             r0_15: b15.reflected.mean.0,
             r089_15: w89.reflected.mean.0,
+            t0: one.transmitted.mean.0,
         };
         m.set_reflectances(r, grammage, sel);
     }

@@ -41,7 +41,7 @@ fn kubelka_stacking_matches_simulated_pad() {
     for (name, p) in [("thin", thin), ("office", office)] {
         let slab = Slab::from_params(&p).unwrap();
         let cfg = PadConfig {
-            samples: 1 << 15,
+            samples: 1 << 16,
             batches: 16,
             seed: 3,
         };

@@ -169,8 +169,11 @@ fn lambertian_gloss_matches_receptor_solid_angle() {
         let expect = 100.0 * (0.8 / std::f64::consts::PI) * omega_cos / f;
         let v = gloss::gloss(&Lambert(0.8), g);
         // The glass reference is averaged over the source aperture in the code
-        // (the closed form uses the nominal angle): a relative 0.5 % covers it at 85 deg.
-        assert!((v / expect - 1.0).abs() < 5e-3, "{}: {v} vs {expect}", g.key);
+        // (the closed form uses the nominal angle): up to 0.3 % at 85 deg. The
+        // BSDF-draw strategy of the MIS adds noise: a Lambertian sends only
+        // ~60 of its 9 x 4096 draws into the round 5-degree window, carrying
+        // ~3 % of the flux with 13 % noise (one sigma 0.4 %); 1 % is 2.5 sigma of both.
+        assert!((v / expect - 1.0).abs() < 1e-2, "{}: {v} vs {expect}", g.key);
     }
 }
 
