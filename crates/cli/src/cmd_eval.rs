@@ -32,7 +32,10 @@ pub struct EvalArgs {
     pub out: Option<String>,
 }
 
-/// Arguments of `paperbsdf albedo`.
+/// Arguments of `paperbsdf albedo`: the fractions of the light arriving from
+/// polar angle `theta_i` (in the x-z plane) that the model reflects and
+/// transmits, i.e. `int f(wi, wo) |cos wo| dwo` over each hemisphere of
+/// outgoing directions, delta lobes included.
 #[derive(clap::Args, Debug)]
 pub struct AlbedoArgs {
     /// Model name (see `eval`).
@@ -84,6 +87,17 @@ pub fn check_angles(v: &[f64], what: &str, lo: f64, hi: f64) -> Result<()> {
     Ok(())
 }
 
+/// BSDF values in the shortest decimal that reads back as the same f64
+/// (Rust's `{:e}`), so other front ends (the Python package) can be checked
+/// against the CLI exactly.
+fn fmt_eval(v: Rgb, rgb: bool) -> String {
+    if rgb {
+        format!("{:e},{:e},{:e}", v.0[0], v.0[1], v.0[2])
+    } else {
+        format!("{:e}", v.0[0])
+    }
+}
+
 fn fmt_value(v: Rgb, rgb: bool) -> String {
     if rgb {
         format!("{:.9e},{:.9e},{:.9e}", v.0[0], v.0[1], v.0[2])
@@ -123,7 +137,7 @@ pub fn run_eval(a: EvalArgs) -> Result<()> {
         text.push_str(&format!("{},{}\n", f.header.join(","), value_header(rgb)));
         for r in &f.rows {
             let v = eval(r.wi, r.wo)?;
-            text.push_str(&format!("{},{}\n", r.fields.join(","), fmt_value(v, rgb)));
+            text.push_str(&format!("{},{}\n", r.fields.join(","), fmt_eval(v, rgb)));
         }
     } else {
         let to = match &a.theta_o {
@@ -141,7 +155,7 @@ pub fn run_eval(a: EvalArgs) -> Result<()> {
                 for &o in &to {
                     let (wi, wo) = in_plane_directions(ti, o, t);
                     let v = eval(wi, wo)?;
-                    text.push_str(&format!("{kind},{ti},{o},{}\n", fmt_value(v, rgb)));
+                    text.push_str(&format!("{kind},{ti},{o},{}\n", fmt_eval(v, rgb)));
                 }
             }
         }

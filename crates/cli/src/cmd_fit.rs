@@ -2,9 +2,9 @@
 //! (DESIGN.md section 5; crate paperbsdf-fit) and writes FIT.json.
 
 use anyhow::{anyhow, bail, Result};
-use paperbsdf_core::Distribution;
+use paperbsdf_core::{Distribution, FaceScattering};
 use paperbsdf_fit::dataset::load_dataset;
-use paperbsdf_fit::models::candidates;
+use paperbsdf_fit::models::candidates_with_faces;
 use paperbsdf_fit::{fit, FitOptions};
 
 /// Arguments of `paperbsdf fit`.
@@ -40,6 +40,14 @@ pub struct FitArgs {
     /// Seed of the global search.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Faces of the paper and reduced-multilayer models: `multiple` (energy-conserving, the default) or
+    /// `single` (Walter's single-scattering faces, as in the paper and Mitsuba's roughdielectric).
+    #[arg(long = "face-scattering", default_value = "multiple", value_parser = parse_face_scattering)]
+    pub face_scattering: FaceScattering,
+}
+
+fn parse_face_scattering(s: &str) -> Result<FaceScattering, String> {
+    s.parse::<FaceScattering>().map_err(|e| e.to_string())
 }
 
 /// Parses a list of distribution names.
@@ -59,7 +67,14 @@ pub fn run(args: FitArgs) -> Result<()> {
     }
     let dists = parse_dists(&args.dists)?;
     let ds = load_dataset(&args.data, args.thickness).map_err(|e| anyhow!(e))?;
-    let cands = candidates(&args.model, ds.thickness, ds.channels == 3, Some(&dists)).map_err(|e| anyhow!(e))?;
+    let cands = candidates_with_faces(
+        &args.model,
+        ds.thickness,
+        ds.channels == 3,
+        Some(&dists),
+        args.face_scattering,
+    )
+    .map_err(|e| anyhow!(e))?;
     let fit_theta_i = (!args.fit_theta_i.is_empty()).then(|| args.fit_theta_i.clone());
     let opts = FitOptions {
         global_samples: args.samples,

@@ -25,7 +25,7 @@ struct Cli {
 enum Command {
     /// Evaluate a model's BSDF f(wi, wo) (without cosine) for given directions or in-plane angles.
     Eval(cmd_eval::EvalArgs),
-    /// Directional albedo (reflectance, transmittance) of a model for light at given polar angles.
+    /// Directional albedo: the fractions of the light arriving at given polar angles that a model reflects and transmits (integral over outgoing directions).
     Albedo(cmd_eval::AlbedoArgs),
     /// Ground truth: Monte Carlo simulation of the physical paper slab.
     Simulate(cmd_simulate::SimulateArgs),

@@ -143,3 +143,45 @@ pub fn sampled_albedo(bsdf: &dyn Bsdf, wo: DVec3, n: usize) -> (Rgb, Rgb) {
     let norm = inv * inv;
     (r * norm, t * norm)
 }
+
+/// Directional albedo for light arriving from `wi`, split into reflection and
+/// transmission: the fractions of the incident flux that leave on each side,
+/// `int f(wi, wo) |cos wo| dwo` over each hemisphere (the integral over the
+/// *outgoing* argument), delta lobes included. Estimated with `n x n`
+/// stratified directions `w'` drawn by [`Bsdf::sample`] started from `wi`
+/// (density `pdf(w', wi)`), weighted by `f(wi, w') |cos w'| / pdf(w', wi)`;
+/// a delta lobe's sample carries its own weight (delta lobes of a sheet in
+/// air are symmetric). Unlike [`sampled_albedo`] it does not rely on the BSDF
+/// being reciprocal.
+pub fn albedo_from(bsdf: &dyn Bsdf, wi: DVec3, n: usize) -> (Rgb, Rgb) {
+    let (mut r, mut t) = (Rgb::ZERO, Rgb::ZERO);
+    let inv = 1.0 / n as f64;
+    let golden = 0.618_033_988_749_894_9;
+    for i in 0..n {
+        for j in 0..n {
+            let k = (i * n + j) as f64;
+            let uc = (0.5 + k * golden).fract();
+            let u = [
+                (i as f64 + 0.5) * inv,
+                (j as f64 + (0.5 + k * 0.754_877_666).fract()) * inv,
+            ];
+            if let Some(s) = bsdf.sample(wi, uc, [u[0], u[1].min(1.0 - 1e-12)]) {
+                let w = if s.flags.is_specular() {
+                    s.weight()
+                } else {
+                    bsdf.eval(wi, s.wi) * (s.wi.z.abs() / s.pdf)
+                };
+                if !w.is_finite() {
+                    continue;
+                }
+                if s.wi.z * wi.z > 0.0 {
+                    r += w;
+                } else {
+                    t += w;
+                }
+            }
+        }
+    }
+    let norm = inv * inv;
+    (r * norm, t * norm)
+}

@@ -17,6 +17,8 @@ pub mod dielectric;
 pub mod fresnel;
 pub mod geometry;
 pub mod microfacet;
+pub mod microsurface;
+pub mod microsurface_tables;
 pub mod models;
 pub mod paper;
 pub mod params;

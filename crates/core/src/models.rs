@@ -19,15 +19,19 @@
 //!   lobe to the inside angle, which no viewer in air sees). For a smooth sheet
 //!   it is a delta lobe with the exact lossless value `(1 - F)/(1 + F)`
 //!   (internal reflections summed);
-//! - the Lambertian body ([`Component::Multiple`]): `k_d / pi` in reflection and
-//!   `k_t / pi` in transmission.
+//! - the Lambertian body ([`Component::Multiple`]): diffuse reflection `k_d`
+//!   and transmission `k_t` of the light that crosses the first face,
+//!   `k Att(mu_i) Att(mu_o) / (pi Abar)` (`Abar = 2 int Att mu dmu`): Lambertian
+//!   inside the glass, seen through its faces.
 //!
 //! The clear transmission carries the fraction `1 - k_d - k_t` of the light
 //! that the Lambertian body does not take (`k_d + k_t <= 1` is required).
-//! The Lambertian terms are added to the surface reflection as the supplement's
-//! baseline does; its albedo may therefore exceed 1 by up to the surface
-//! reflectance at grazing incidence (the model is a fitting baseline, not a
-//! physical one).
+//! **Bounded as a whole (our change to the supplement's baseline).** The
+//! supplement adds flat `k_d / pi`, `k_t / pi` to the surface reflection, so
+//! its albedo reached 1.84 (`k_d = 1`, `eta = 5`). Here the body only gets the
+//! light that the face lets in: for light at `mu` the albedo is
+//! `R_s(mu) + Att(mu) (k_d + k_t + (1 - k_d - k_t) X) <= R_s(mu) + Att(mu) <= 1`
+//! with `X <= 1` the clear part's exit fraction.
 
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample};
 use crate::dielectric::{RoughDielectric, RoughDielectricParams};
@@ -149,7 +153,7 @@ impl LambertGlass {
     /// The model of `p` (validated).
     pub fn new(p: &LambertGlassParams) -> Result<LambertGlass, ParamError> {
         p.validate()?;
-        let face = Face::new(p.dist, p.eta, p.m, true, "")?;
+        let face = Face::walter(p.dist, p.eta, p.m, true, "")?;
         let beck = p.dist == Distribution::Beckmann;
         let kernel = SheetKernel::new([(p.eta, p.m, beck), (p.eta, p.m, beck)]);
         let (k_d, k_t) = (p.k_d.rgb(), p.k_t.rgb());
@@ -176,11 +180,11 @@ impl LambertGlass {
                 out += Rgb::splat(self.face.reflection(to_face_frame(wi, e), to_face_frame(wo, e)));
             }
             if set.contains(Component::Multiple) {
-                out += self.k_d / PI;
+                out += self.k_d * self.body(wi, wo);
             }
         } else {
             if set.contains(Component::Multiple) {
-                out += self.k_t / PI;
+                out += self.k_t * self.body(wi, wo);
             }
             if set.contains(Component::Direct) && !self.kernel.is_delta() {
                 let k = self.kernel.eval(DVec2::new(-wi.x, -wi.y), DVec2::new(wo.x, wo.y), 1.0);
@@ -190,12 +194,18 @@ impl LambertGlass {
         out
     }
 
+    /// The Lambertian body's shape `Att(mu_i) Att(mu_o) / (pi Abar)` (module doc).
+    #[inline]
+    fn body(&self, wi: DVec3, wo: DVec3) -> f64 {
+        self.face.att(wi.z.abs()) * self.face.att(wo.z.abs()) / (PI * self.face.abar)
+    }
+
     fn lobe_probs(&self, wo: DVec3) -> [f64; 4] {
         let mu = wo.z.abs();
         let est = [
             self.face.r_out(mu),
-            self.k_d.mean(),
-            self.k_t.mean(),
+            self.k_d.mean() * self.face.att(mu),
+            self.k_t.mean() * self.face.att(mu),
             self.clear.mean() * self.face.att(mu) * self.face.att(mu),
         ];
         let present = [!self.face.is_index_matched(), est[1] > 0.0, est[2] > 0.0, est[3] > 0.0];
@@ -255,7 +265,7 @@ impl Bsdf for LambertGlass {
             0 => {
                 if self.face.is_smooth() {
                     let wi = DVec3::new(-wo.x, -wo.y, wo.z);
-                    let f = fresnel_dielectric(wo.z.abs(), self.face.eta());
+                    let f = fresnel_dielectric(wo.z.abs(), self.face.bd.eta);
                     return Some(BsdfSample {
                         wi,
                         f: Rgb::splat(f / wi.z.abs()),
@@ -273,7 +283,7 @@ impl Bsdf for LambertGlass {
             _ => {
                 if self.kernel.is_delta() {
                     let wi = -wo;
-                    let f = fresnel_dielectric(wo.z.abs(), self.face.eta());
+                    let f = fresnel_dielectric(wo.z.abs(), self.face.bd.eta);
                     let t = if self.face.is_smooth() {
                         (1.0 - f) / (1.0 + f)
                     } else {

@@ -7,7 +7,11 @@
 //! in (weight `1 - F`), first collision within the slab, HG scattering,
 //! attenuation to the exit face, refract out (weight `1 - F` at the inside
 //! angle, zero beyond the critical angle). The simulation counts flux, the
-//! model radiance: agreement checks the `1/eta^2` of DESIGN.md 4.4.
+//! model radiance: agreement checks the `1/eta^2` of DESIGN.md 4.4. Faces of
+//! unequal index are the physical sheet of `paperbsdf_core::sheet`: a base of
+//! index `eta_b` under a thin front coating of index `eta_f`, whose two smooth
+//! boundaries (air/coating, coating/base) the simulation crosses with their
+//! internal reflections summed (written out here from Fresnel's formula).
 
 use paperbsdf_core::fresnel::fresnel_dielectric;
 use paperbsdf_core::geometry::spherical_direction;
@@ -64,8 +68,32 @@ fn first_order_mc(p: &PaperParams, theta: f64, n: usize, seed: u64) -> (f64, f64
     let sigma_t = p.sigma_a.rgb().0[0] + p.sigma_s.rgb().0[0];
     let a = p.sigma_s.rgb().0[0] / sigma_t;
     let mu0 = theta.cos();
-    let t_in = 1.0 - fresnel_dielectric(mu0, p.eta_f);
-    let sin_i = theta.sin() / p.eta_f;
+    let nu = p.eta_b / p.eta_f;
+    // Coating cosine of a base cosine (None: total internal reflection at the coating/base boundary).
+    let coat_cos = |mu_b: f64| {
+        let s2 = (1.0 - mu_b * mu_b) * nu * nu;
+        (s2 < 1.0).then(|| (1.0 - s2).sqrt())
+    };
+    // Front: air -> coating -> base, internal reflections in the coating summed.
+    let front_in = |mu_air: f64| {
+        let f1 = fresnel_dielectric(mu_air, p.eta_f);
+        let sc = (1.0 - mu_air * mu_air).sqrt() / p.eta_f;
+        let mu_c = (1.0 - sc * sc).sqrt();
+        let f2 = fresnel_dielectric(mu_c, nu);
+        let r1 = fresnel_dielectric(-mu_c, p.eta_f);
+        (1.0 - f1) * (1.0 - f2) / (1.0 - f2 * r1)
+    };
+    // Front from inside the base at base cosine mu_b.
+    let front_out = |mu_b: f64| match coat_cos(mu_b) {
+        None => 0.0,
+        Some(mu_c) => {
+            let f2 = fresnel_dielectric(mu_c, nu);
+            let r1 = fresnel_dielectric(-mu_c, p.eta_f);
+            (1.0 - f2) * (1.0 - r1) / (1.0 - f2 * r1)
+        }
+    };
+    let t_in = front_in(mu0);
+    let sin_i = theta.sin() / p.eta_b;
     let mu_i = (1.0 - sin_i * sin_i).sqrt();
     let dir = DVec3::new(-sin_i, 0.0, -mu_i);
     let len = p.d / mu_i;
@@ -80,14 +108,14 @@ fn first_order_mc(p: &PaperParams, theta: f64, n: usize, seed: u64) -> (f64, f64
         let w = direction_at(dir, sample_hg_cos(g, rng.gen()), rng.gen());
         let mut wt = t_in * p_coll * a;
         let up = w.z > 0.0;
-        let (dist, eta) = if up {
-            (z / w.z, p.eta_f)
-        } else {
-            ((p.d - z) / -w.z, p.eta_b)
-        };
+        let dist = if up { z / w.z } else { (p.d - z) / -w.z };
         wt *= (-sigma_t * dist).exp();
         // Leaving: Fresnel from inside (cosine negative = from the eta side).
-        wt *= 1.0 - fresnel_dielectric(-w.z.abs(), eta);
+        wt *= if up {
+            front_out(w.z)
+        } else {
+            1.0 - fresnel_dielectric(-w.z.abs(), p.eta_b)
+        };
         if up {
             r += wt;
             r2 += wt * wt;
@@ -196,8 +224,9 @@ fn reduced_multilayer_is_paper_with_att_one() {
             let wo = DVec3::new(wo.x, wo.y, so * wo.z);
             let (e, x) = (if si > 0.0 { 0 } else { 1 }, if so > 0.0 { 0 } else { 1 });
             let att = paper.att(e, wi.z.abs()) * paper.att(x, wo.z.abs());
-            let s_p = paper.eval_component(wi, wo, Component::Single);
-            let s_r = reduced.eval_component(wi, wo, Component::Single);
+            let (kp, kr) = (paper.subsurface_bound(), reduced.subsurface_bound());
+            let s_p = paper.eval_component(wi, wo, Component::Single) / kp;
+            let s_r = reduced.eval_component(wi, wo, Component::Single) / kr;
             for c in 0..3 {
                 assert!(
                     (s_r.0[c] * att - s_p.0[c]).abs() <= 1e-12 * s_p.0[c].max(1e-300),
@@ -208,8 +237,10 @@ fn reduced_multilayer_is_paper_with_att_one() {
                 paper.eval_component(wi, wo, Component::Surface),
                 reduced.eval_component(wi, wo, Component::Surface)
             );
-            let (rd, td) = reduced.multipole_rd_td(e);
-            let flat = if e == x { rd } else { td } / PI;
+            let (rd, _) = reduced.multipole_rd_td(e);
+            // Transmission is the mean of both faces of entry (reciprocity).
+            let td = (reduced.multipole_rd_td(0).1 + reduced.multipole_rd_td(1).1) * 0.5;
+            let flat = if e == x { rd } else { td } * (kr / PI);
             let m = reduced.eval_component(wi, wo, Component::Multiple);
             for c in 0..3 {
                 assert!(
@@ -221,12 +252,21 @@ fn reduced_multilayer_is_paper_with_att_one() {
     }
 }
 
-/// The Paper BSDF's multiple scattering (energy bound off) is
-/// `Att(wi) R_d Att(wo) / (pi eta^2 (1 - rho_in))` (DESIGN.md 4.5), with
-/// `rho_in` from the boundary's own integrals.
+/// The Paper BSDF's multiple scattering in the multipole normalisation
+/// (energy bound off, Walter's faces) is
+/// `kappa Att(wi) R_d Att(wo) / (pi eta^2 (1 - rho_in))` (DESIGN.md 4.5),
+/// with `rho_in` from the boundary's own integrals, and in transmission the
+/// mean of both faces of entry (reciprocity). The model writes
+/// `eta^2 Tbar_in` as `Abar` (the same by reciprocity of the face's
+/// transmission); the tables agree on that to 0.5%, the tolerance here.
 #[test]
 fn multiple_scattering_normalisation() {
-    let p = rough_params();
+    let p = PaperParams {
+        face_scattering: paperbsdf_core::FaceScattering::Single,
+        eta_b: 1.5,
+        eta_f: 1.5,
+        ..rough_params()
+    };
     let paper = PaperBsdf::with_options(
         &p,
         PaperOptions {
@@ -243,15 +283,18 @@ fn multiple_scattering_normalisation() {
     let wi = spherical_direction(0.4, 0.0);
     let wo = spherical_direction(0.9, 2.0);
     let wt = DVec3::new(wo.x, wo.y, -wo.z);
-    let (rd, td) = paper.multipole_rd_td(0);
+    let k = paper.subsurface_bound();
+    let (rd, td0) = paper.multipole_rd_td(0);
+    let td1 = paper.multipole_rd_td(1).1;
     let att = |f, w: DVec3| paper.att(f, w.z.abs());
     let mr = paper.eval_component(wi, wo, Component::Multiple);
     let mt = paper.eval_component(wi, wt, Component::Multiple);
-    let er = rd * (att(0, wi) * att(0, wo) / (PI * p.eta_f * p.eta_f * (1.0 - rho_f)));
-    let et = td * (att(0, wi) * att(1, wt) / (PI * p.eta_b * p.eta_b * (1.0 - rho_b)));
+    let n2 = p.eta_b * p.eta_b;
+    let er = rd * (k * att(0, wi) * att(0, wo) / (PI * n2 * (1.0 - rho_f)));
+    let et = (td0 / (1.0 - rho_b) + td1 / (1.0 - rho_f)) * (0.5 * k * att(0, wi) * att(1, wt) / (PI * n2));
     for c in 0..3 {
-        assert!((mr.0[c] - er.0[c]).abs() < 1e-12 * er.0[c]);
-        assert!((mt.0[c] - et.0[c]).abs() < 1e-12 * et.0[c]);
+        assert!((mr.0[c] - er.0[c]).abs() < 5e-3 * er.0[c], "R {mr:?} vs {er:?}");
+        assert!((mt.0[c] - et.0[c]).abs() < 5e-3 * et.0[c], "T {mt:?} vs {et:?}");
     }
 }
 

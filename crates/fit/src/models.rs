@@ -30,7 +30,7 @@
 use crate::model::{Evaluable, FitModel, ParamSpec, Scale};
 use paperbsdf_core::models::{ComponentModel, LambertGlass, LambertGlassParams};
 use paperbsdf_core::paper::{Component, PaperBsdf};
-use paperbsdf_core::{Bsdf, Colour, DVec3, Distribution, PaperParams, Rgb};
+use paperbsdf_core::{Bsdf, Colour, DVec3, Distribution, FaceScattering, PaperParams, Rgb};
 
 /// Model names accepted by [`candidates`].
 pub const MODEL_NAMES: &[&str] = &["paper", "lambert-glass", "reduced-multilayer"];
@@ -67,6 +67,7 @@ pub struct PaperFit {
     rgb: bool,
     reduced: bool,
     specs: Vec<ParamSpec>,
+    face_scattering: FaceScattering,
 }
 
 impl PaperFit {
@@ -92,7 +93,14 @@ impl PaperFit {
             rgb,
             reduced,
             specs,
+            face_scattering: FaceScattering::default(),
         }
+    }
+
+    /// The same variant with faces that scatter once or many times among their microfacets.
+    pub fn with_face_scattering(mut self, fs: FaceScattering) -> Self {
+        self.face_scattering = fs;
+        self
     }
 
     /// The parameter set of values `x`.
@@ -113,7 +121,7 @@ impl PaperFit {
             m_b: r[6],
             dist_f: self.dist_f,
             dist_b: self.dist_b,
-            face_scattering: Default::default(),
+            face_scattering: self.face_scattering,
         }
     }
 }
@@ -259,6 +267,18 @@ pub fn candidates(
     rgb: bool,
     dists: Option<&[Distribution]>,
 ) -> Result<Vec<Box<dyn FitModel>>, String> {
+    candidates_with_faces(name, d, rgb, dists, FaceScattering::default())
+}
+
+/// [`candidates`] with the faces' microfacet scattering of the Paper BSDF
+/// and the reduced multilayer model (`face_scattering`; `lambert-glass` has Walter's faces).
+pub fn candidates_with_faces(
+    name: &str,
+    d: Option<f64>,
+    rgb: bool,
+    dists: Option<&[Distribution]>,
+    face_scattering: FaceScattering,
+) -> Result<Vec<Box<dyn FitModel>>, String> {
     let ds: Vec<Distribution> = dists.map(|d| d.to_vec()).unwrap_or_else(|| DISTS.to_vec());
     match name {
         "paper" | "reduced-multilayer" => {
@@ -271,7 +291,9 @@ pub fn candidates(
             let mut v: Vec<Box<dyn FitModel>> = Vec::new();
             for &f in &ds {
                 for &b in &ds {
-                    v.push(Box::new(PaperFit::new(d, f, b, rgb, name == "reduced-multilayer")));
+                    v.push(Box::new(
+                        PaperFit::new(d, f, b, rgb, name == "reduced-multilayer").with_face_scattering(face_scattering),
+                    ));
                 }
             }
             Ok(v)

@@ -98,9 +98,11 @@ impl LoadedModel {
     /// Directional albedo `(reflectance, transmittance)` for light arriving from
     /// direction `w` (pointing toward the light): flux fractions. The rough
     /// dielectric uses the converged quadrature of `boundary` (importance
-    /// transport, no eta^2, as Mitsuba's albedo); the slab models, which have air
-    /// on both sides and are reciprocal, use 512 x 512 stratified samples of their
-    /// own sampling routine ([`paperbsdf_core::bsdf::sampled_albedo`]).
+    /// transport, no eta^2, as Mitsuba's albedo); the slab models integrate
+    /// `f(w, wo) |cos wo|` over the outgoing directions with 512 x 512
+    /// stratified samples of their own sampling routine
+    /// ([`paperbsdf_core::bsdf::albedo_from`]): the physical fractions of the
+    /// light arriving from `w` that are reflected and transmitted.
     pub fn albedo(&self, w: DVec3) -> (Rgb, Rgb) {
         match self {
             LoadedModel::RoughDielectric(b) => {
@@ -109,7 +111,7 @@ impl LoadedModel {
             }
             _ => {
                 let bsdf: &dyn Bsdf = self.model();
-                paperbsdf_core::bsdf::sampled_albedo(bsdf, w, 512)
+                paperbsdf_core::bsdf::albedo_from(bsdf, w, 512)
             }
         }
     }

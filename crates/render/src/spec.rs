@@ -172,6 +172,8 @@ pub struct MaterialSpec {
     pub dist_f: Option<Distribution>,
     /// paper: back face distribution.
     pub dist_b: Option<Distribution>,
+    /// paper: the faces' microfacet scattering, `"multiple"` (default) or `"single"`.
+    pub face_scattering: Option<paperbsdf_core::FaceScattering>,
     /// paper: thickness map.
     pub thickness_map: Option<ThicknessMapSpec>,
     /// paper: ink map.
@@ -472,7 +474,7 @@ fn grey_image(
 
 /// Keys set in a material table that do not belong to its type.
 fn foreign_keys(m: &MaterialSpec, allowed: &[&str]) -> Vec<&'static str> {
-    let present: [(&'static str, bool); 20] = [
+    let present: [(&'static str, bool); 21] = [
         ("reflectance", m.reflectance.is_some()),
         ("params", m.params.is_some()),
         ("eta", m.eta.is_some()),
@@ -491,6 +493,7 @@ fn foreign_keys(m: &MaterialSpec, allowed: &[&str]) -> Vec<&'static str> {
         ("m_b", m.m_b.is_some()),
         ("dist_f", m.dist_f.is_some()),
         ("dist_b", m.dist_b.is_some()),
+        ("face_scattering", m.face_scattering.is_some()),
         ("thickness_map", m.thickness_map.is_some()),
         ("ink_map", m.ink_map.is_some()),
     ];
@@ -595,7 +598,10 @@ fn paper_params_over(
             .dist_b
             .or(base.as_ref().map(|b| b.dist_b))
             .unwrap_or(Distribution::Ggx),
-        face_scattering: base.as_ref().map(|b| b.face_scattering).unwrap_or_default(),
+        face_scattering: m
+            .face_scattering
+            .or(base.as_ref().map(|b| b.face_scattering))
+            .unwrap_or_default(),
     };
     p.validate().map_err(|e| err(file, entry, e.to_string()))?;
     Ok(p)
@@ -622,6 +628,7 @@ fn material(name: &str, m: &MaterialSpec, file: &str, res: &Resources) -> Result
             "m_b",
             "dist_f",
             "dist_b",
+            "face_scattering",
             "thickness_map",
             "ink_map",
         ],

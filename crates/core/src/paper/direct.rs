@@ -84,13 +84,30 @@ impl SheetKernel {
     /// Draws an offset on the plane with density [`SheetKernel::k`] of its length.
     #[inline]
     pub fn sample_offset(&self, u: [f64; 2]) -> DVec2 {
-        let r2 = match self.shape {
-            KernelShape::Delta => 0.0,
-            KernelShape::Ggx(b) => b * b * u[0] / (1.0 - u[0]).max(1e-300),
-            KernelShape::Gauss(b) => -b * b * (1.0 - u[0]).max(1e-300).ln(),
-        };
         let (s, c) = crate::geometry::sin_cos_2pi(u[1]);
-        r2.sqrt() * DVec2::new(c, s)
+        self.radius_at(u[0]) * DVec2::new(c, s)
+    }
+
+    /// The kernel's mass within radius `r` (its CDF in `r`; 1 for a delta).
+    #[inline]
+    pub fn cdf(&self, r: f64) -> f64 {
+        let r2 = r * r;
+        match self.shape {
+            KernelShape::Delta => 1.0,
+            KernelShape::Ggx(b) => r2 / (r2 + b * b),
+            KernelShape::Gauss(b) => -(-r2 / (b * b)).exp_m1(),
+        }
+    }
+
+    /// The radius at which [`SheetKernel::cdf`] reaches `u` in [0, 1) (the
+    /// inverse used by [`SheetKernel::sample_offset`]).
+    #[inline]
+    pub fn radius_at(&self, u: f64) -> f64 {
+        match self.shape {
+            KernelShape::Delta => 0.0,
+            KernelShape::Ggx(b) => b * (u / (1.0 - u).max(1e-300)).sqrt(),
+            KernelShape::Gauss(b) => b * (-(-u).ln_1p()).max(0.0).sqrt(),
+        }
     }
 
     /// Whether the lobe is a delta.

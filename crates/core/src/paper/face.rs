@@ -1,25 +1,49 @@
-//! One face of the slab as the Paper BSDF sees it (DESIGN.md 4.1): the rough
-//! dielectric boundary in its own frame (its outside is `+z`), its tabulated
-//! integrals (`Att`, outside reflectance, `rho_in`, `Tbar_in`), and helpers for
-//! the smooth refraction through the macro normal that the single- and
-//! multiple-scattering terms use (DESIGN.md 4.4).
+//! One face of the sheet as the Paper BSDF sees it (DESIGN.md 4.1, and the
+//! physical sheet of [`crate::sheet`]): its reflection, its directional and
+//! hemispherical integrals (`Att`, outside reflectance, `rho_in`, `Tbar_in`),
+//! and the smooth refraction into the base through the macro normal that the
+//! single- and multiple-scattering terms use (DESIGN.md 4.4).
+//!
+//! A face is built in three steps, each a closed form on the tabulated
+//! integrals of Walter's rough interface ([`crate::boundary`]):
+//!
+//! 1. **Walter's interface** (`face_scattering = "single"`): the tables as they are.
+//! 2. **Energy compensation** (`face_scattering = "multiple"`, rough faces only;
+//!    our form, after Kulla & Conty 2017). Walter's interface loses
+//!    `L_o(mu) = 1 - R(mu) - T(mu)` of the light arriving from outside and
+//!    `L_i(mu)` of the light arriving from inside: the light that the exact
+//!    walk on the microsurface (Heitz et al. 2016, [`crate::microsurface`])
+//!    scatters more than once. The compensated face reflects `(1 - k_o) L_o`
+//!    and transmits `k_o L_o` of it (from inside `(1 - k_i) L_i` and `k_i L_i`),
+//!    with the outside reflection as the separable, reciprocal lobe
+//!    `f = (1 - k_o) L_o(mu_i) L_o(mu_o) / (pi Lbar_o)` (`Lbar = 2 int L mu dmu`),
+//!    so each direction's `R + T` is exactly 1 from both sides. `k_o` is the
+//!    transmitted share of the lost energy measured by the walk
+//!    ([`crate::microsurface_tables`]); `k_i` follows from reciprocity of the
+//!    transmission, `k_o Lbar_o = eta^2 k_i Lbar_i` (the flux transmitted by
+//!    diffuse light is `eta^2` times larger from outside).
+//! 3. **The coating** (front face with `eta_f != eta_b`): the interface of
+//!    steps 1-2 over the smooth coating/base boundary of relative index
+//!    `nu = eta_b / eta_f`, combined by adding with the internal reflections in
+//!    the coating summed (`Att = T_r (1 - F) / (1 - F R_in,r)`; the light the
+//!    smooth boundary sends back out is a second separable reflection lobe).
+//!    The directional spread inside the coating is neglected (each direction
+//!    refracts through the macro normal), an approximation measured against
+//!    the simulator, which follows the coating exactly. The combination keeps
+//!    `R + T = 1` for energy-conserving interfaces.
 //!
 //! The back face (`z = -d`) is the same kind of object seen with `z` flipped:
 //! [`to_face_frame`] maps a direction on the back side to the face's frame.
 
-use crate::boundary::SurfaceIntegrals;
+use crate::boundary::{critical_mu, SurfaceIntegrals};
 use crate::dielectric::{Interface, RoughDielectric};
 use crate::fresnel::fresnel_dielectric;
 use crate::microfacet::{Distribution, Microfacet};
-use crate::params::ParamError;
+use crate::params::{FaceScattering, ParamError};
 use crate::quadrature::gauss_legendre_01;
+use crate::sheet::Sheet;
 use glam::DVec3;
-
-/// The integrals of a boundary, in one place so that the switch to another
-/// constructor (e.g. [`SurfaceIntegrals::direct`]) is one line.
-fn surface_integrals(b: &RoughDielectric) -> SurfaceIntegrals {
-    SurfaceIntegrals::new(b)
-}
+use std::f64::consts::PI;
 
 /// Mirrors `w` into the frame of the face on side `side` (0 front: identity; 1 back: `z -> -z`).
 #[inline]
@@ -49,141 +73,490 @@ fn reflection_half(wi: DVec3, wo: DVec3) -> Option<(f64, f64)> {
     Some((zs * zs / (2.0 * k), (0.5 * k).sqrt().min(1.0)))
 }
 
-/// A face of the slab with its precomputed integrals.
-#[derive(Clone, Debug)]
-pub(crate) struct Face {
-    /// The boundary, in the face's own frame (outside = `+z`).
-    pub bd: RoughDielectric,
-    /// Its integrals.
-    pub si: SurfaceIntegrals,
-    /// Whether `Att` is used; `false` sets every `Att` to 1 (the reduced multilayer model).
-    pub use_att: bool,
-    /// `Abar = 2 int_0^1 Att(mu) mu dmu` (1 when `use_att` is false).
-    pub abar: f64,
-    /// `Att` of a rough face at `mu = t^2`, `t` uniform on [`NA`] nodes (a
-    /// cheaper copy of the boundary tables for the BSDF's inner loop).
-    att_tab: [f64; NA],
-    /// Outside reflectance of a rough face on the same nodes.
-    r_tab: [f64; NA],
-    /// `1 / eta` (the BSDF's inner loop multiplies rather than divides).
-    inv_eta: f64,
-    /// `1 / eta^2`.
-    inv_eta2: f64,
-}
+/// Nodes of the per-face tables in the outside cosine (`mu = t^2`, `t` uniform).
+pub(crate) const NA: usize = 65;
 
-/// Nodes of the per-face copies of `Att` and the outside reflectance.
-const NA: usize = 65;
-
+/// [`lerp_sqrt`] at `mu`.
 #[inline]
 fn lerp_t(tab: &[f64; NA], mu: f64) -> f64 {
     lerp_sqrt(tab, mu.abs().min(1.0).sqrt())
 }
 
-/// [`lerp_t`] at `mu = st^2` for a precomputed `st = sqrt(min(|mu|, 1))`.
+/// Linear interpolation of a node table at `mu = st^2` for a precomputed `st = sqrt(min(|mu|, 1))`.
 #[inline]
-fn lerp_sqrt(tab: &[f64; NA], st: f64) -> f64 {
+pub(crate) fn lerp_sqrt(tab: &[f64; NA], st: f64) -> f64 {
     let x = st * (NA - 1) as f64;
     let i = (x as usize).min(NA - 2);
     let f = x - i as f64;
     tab[i] * (1.0 - f) + tab[i + 1] * f
 }
 
+/// `2 int_0^1 g(mu) mu dmu` of a table interpolated by [`lerp_sqrt`]: with
+/// `mu = t^2` the integrand is `4 t^3 g(t)`, a polynomial of degree 4 on each
+/// interval, integrated exactly by 3-point Gauss-Legendre per interval. Energy
+/// checks rely on this being the integral of exactly what `eval` interpolates.
+pub(crate) fn hemispherical_of_table(tab: &[f64; NA]) -> f64 {
+    const X: [f64; 3] = [0.112_701_665_379_258_31, 0.5, 0.887_298_334_620_741_7];
+    const W: [f64; 3] = [5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0];
+    let h = 1.0 / (NA - 1) as f64;
+    let mut s = 0.0;
+    for i in 0..NA - 1 {
+        for (x, w) in X.iter().zip(W) {
+            let t = (i as f64 + x) * h;
+            let g = tab[i] * (1.0 - x) + tab[i + 1] * x;
+            s += w * h * 4.0 * t * t * t * g;
+        }
+    }
+    s
+}
+
+/// `2 int_0^1 g(mu) mu dmu` of a function by Gauss-Legendre in `t = sqrt(mu)`
+/// on `[0, t_c]` and `[t_c, 1]` (a kink of total internal reflection at
+/// `mu = t_c^2` falls on the split).
+fn hemispherical(g: impl Fn(f64) -> f64, mu_split: f64) -> f64 {
+    static GL: std::sync::OnceLock<(Vec<f64>, Vec<f64>)> = std::sync::OnceLock::new();
+    let (x, w) = GL.get_or_init(|| gauss_legendre_01(24));
+    let tc = mu_split.clamp(0.0, 1.0).sqrt();
+    let mut s = 0.0;
+    for (lo, hi) in [(0.0, tc), (tc, 1.0)] {
+        let len = hi - lo;
+        if len <= 0.0 {
+            continue;
+        }
+        for (xi, wi) in x.iter().zip(w) {
+            let t = lo + len * xi;
+            s += wi * len * 4.0 * t * t * t * g(t * t);
+        }
+    }
+    s
+}
+
+/// The rough (or smooth, or index-matched) interface of a face with the
+/// energy compensation of step 2 (module doc): directional reflectances and
+/// transmittances from outside (at the outside cosine) and from inside (at
+/// the cosine on the interface's inner side).
+struct Interface4 {
+    si: SurfaceIntegrals,
+    kind: Interface,
+    eta: f64,
+    /// `(k_o, k_i)`: the transmitted shares of the lost energy (0 for Walter's faces).
+    k: (f64, f64),
+    /// Whether the compensation is on.
+    comp: bool,
+}
+
+impl Interface4 {
+    fn new(bd: &RoughDielectric, fs: FaceScattering) -> Self {
+        let si = SurfaceIntegrals::new(bd);
+        let mut me = Interface4 {
+            si,
+            kind: bd.interface,
+            eta: bd.eta,
+            k: (0.0, 0.0),
+            comp: false,
+        };
+        if fs == FaceScattering::Multiple && matches!(bd.interface, Interface::Rough(_)) {
+            let lbar_o = 1.0 - hemispherical(|mu| me.si.att(mu) + me.si.r_out(mu), 0.0);
+            let lbar_i = (1.0 - me.si.rho_in - me.si.tbar_in).max(0.0);
+            let lost = crate::microsurface_tables::lost_energy(bd.dist, bd.eta, bd.m);
+            let tot = lost.t_out2 + lost.r_out2;
+            let mut k_o = if tot > 0.0 {
+                (lost.t_out2 / tot).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let e2 = bd.eta * bd.eta;
+            let k_i = if lbar_i > 1e-12 {
+                let k_i = k_o * lbar_o.max(0.0) / (e2 * lbar_i);
+                if k_i > 1.0 {
+                    // The walk's share is not reachable with these lobe shapes:
+                    // keep reciprocity and transmit all that is lost from inside.
+                    k_o = e2 * lbar_i / lbar_o;
+                    1.0
+                } else {
+                    k_i
+                }
+            } else {
+                k_o = 0.0;
+                0.0
+            };
+            me.k = (k_o, k_i);
+            me.comp = true;
+        }
+        me
+    }
+
+    /// Walter's reflectance from outside (the closed-form lobe's albedo), or Fresnel.
+    fn r_walter(&self, mu: f64) -> f64 {
+        match self.kind {
+            Interface::IndexMatched => 0.0,
+            Interface::Smooth => fresnel_dielectric(mu, self.eta),
+            Interface::Rough(_) => self.si.r_out(mu),
+        }
+    }
+    /// Walter's transmittance from outside (the collimated part).
+    fn t_walter(&self, mu: f64) -> f64 {
+        match self.kind {
+            Interface::IndexMatched => 1.0,
+            Interface::Smooth => 1.0 - fresnel_dielectric(mu, self.eta),
+            Interface::Rough(_) => self.si.att(mu),
+        }
+    }
+    /// Energy lost by Walter's interface for light from outside at `mu`.
+    fn lost_out(&self, mu: f64) -> f64 {
+        if !self.comp {
+            return 0.0;
+        }
+        (1.0 - self.si.att(mu) - self.si.r_out(mu)).max(0.0)
+    }
+    /// Energy lost for light from inside at inner cosine `mu`.
+    fn lost_in(&self, mu: f64) -> f64 {
+        if !self.comp {
+            return 0.0;
+        }
+        (1.0 - self.si.r_in(mu) - self.si.t_in(mu)).max(0.0)
+    }
+    /// Transmittance from outside, all orders.
+    fn t_out(&self, mu: f64) -> f64 {
+        self.t_walter(mu) + self.k.0 * self.lost_out(mu)
+    }
+    /// Reflectance from inside at inner cosine `mu` (TIR included), all orders.
+    fn r_in(&self, mu: f64) -> f64 {
+        match self.kind {
+            Interface::IndexMatched => 0.0,
+            Interface::Smooth => fresnel_dielectric(-mu, self.eta),
+            Interface::Rough(_) => self.si.r_in(mu) + (1.0 - self.k.1) * self.lost_in(mu),
+        }
+    }
+    /// Transmittance from inside at inner cosine `mu`, all orders.
+    fn t_in(&self, mu: f64) -> f64 {
+        match self.kind {
+            Interface::IndexMatched => 1.0,
+            Interface::Smooth => 1.0 - fresnel_dielectric(-mu, self.eta),
+            Interface::Rough(_) => self.si.t_in(mu) + self.k.1 * self.lost_in(mu),
+        }
+    }
+    /// `(rho_in, Tbar_in)` for diffuse light from inside, all orders.
+    fn hemi_in(&self) -> (f64, f64) {
+        let lbar_i = if self.comp {
+            (1.0 - self.si.rho_in - self.si.tbar_in).max(0.0)
+        } else {
+            0.0
+        };
+        (
+            self.si.rho_in + (1.0 - self.k.1) * lbar_i,
+            self.si.tbar_in + self.k.1 * lbar_i,
+        )
+    }
+}
+
+/// A separable, reciprocal diffuse reflection lobe `f = c E(mu_i) E(mu_o)` of a face.
+#[derive(Clone, Debug)]
+struct SeparableLobe {
+    /// `E` on the [`NA`] nodes.
+    e: [f64; NA],
+    /// The constant `c`.
+    c: f64,
+    /// `c pi Ebar`: the lobe's albedo is `c pi Ebar E(mu)`.
+    albedo_scale: f64,
+}
+
+impl SeparableLobe {
+    /// The lobe whose albedo for light at `mu` is `share * E(mu)`.
+    fn new(e: [f64; NA], share: f64) -> Option<Self> {
+        let ebar = hemispherical_of_table(&e);
+        if ebar <= 1e-12 || share <= 0.0 {
+            return None;
+        }
+        let c = share / (PI * ebar);
+        Some(SeparableLobe {
+            e,
+            c,
+            albedo_scale: share,
+        })
+    }
+}
+
+/// A face of the sheet with its precomputed integrals (module doc).
+#[derive(Clone, Debug)]
+pub(crate) struct Face {
+    /// The rough interface with the air, in the face's own frame (outside = `+z`).
+    pub bd: RoughDielectric,
+    /// Whether `Att` is used; `false` sets every `Att` to 1 (the reduced multilayer model).
+    pub use_att: bool,
+    /// `Abar = 2 int_0^1 Att(mu) mu dmu` (1 when `use_att` is false).
+    pub abar: f64,
+    /// Transmittance from outside into the base, all orders (`Att`), on the [`NA`] nodes.
+    att_tab: [f64; NA],
+    /// The collimated part of `Att` (Walter's first order through the coating):
+    /// the light that direct transmission carries.
+    att_dir_tab: [f64; NA],
+    /// Reflectance from outside, everything (Walter's lobe, the separable lobes, or the delta).
+    r_tab: [f64; NA],
+    /// Reflectance of the separable lobes alone (for the sampler's estimates).
+    r_lobes_tab: [f64; NA],
+    /// Separable reflection lobes: the compensation and the coating's (at most two).
+    lobes: Vec<SeparableLobe>,
+    /// `rho_in` and `Tbar_in` for diffuse light from inside the base.
+    rho_in: f64,
+    tbar_in: f64,
+    /// The compensated interface (for the inside reflectance of a delta face).
+    iface_k: (f64, f64),
+    /// `nu = eta_b / eta_f` of a coating.
+    coating: Option<f64>,
+    /// Index of the base (the medium the face refracts into).
+    n: f64,
+    /// `1 / n`.
+    inv_n: f64,
+    /// `1 / n^2`.
+    inv_n2: f64,
+    /// `1 / eta^2` of the rough interface (Fresnel of its reflection lobe).
+    inv_eta2: f64,
+    /// A smooth face without a coating: `Att` and the reflectance are exact
+    /// Fresnel (its curve is too steep at grazing for the node tables).
+    exact_smooth: bool,
+}
+
+/// Cosine in the medium of relative index `eta` of the smooth refraction of a
+/// direction at cosine `mu` outside; `None` at total internal reflection (`eta < 1`).
+#[inline]
+fn refracted_cos(mu: f64, eta: f64) -> Option<f64> {
+    let s2 = (1.0 - mu * mu) / (eta * eta);
+    (s2 < 1.0).then(|| (1.0 - s2).sqrt())
+}
+
 impl Face {
-    /// The face `(dist, eta, m)`; errors name the parameters with `suffix` (`_f`, `_b`, or empty).
-    pub fn new(dist: Distribution, eta: f64, m: f64, use_att: bool, suffix: &str) -> Result<Face, ParamError> {
+    /// A face of Walter's interface alone, of base index `eta` (as the glass
+    /// of `lambert-glass`); errors name the parameters with `suffix`.
+    pub fn walter(dist: Distribution, eta: f64, m: f64, use_att: bool, suffix: &str) -> Result<Face, ParamError> {
         let bd = RoughDielectric::new(dist, eta, m).map_err(|e| e.with_suffix(suffix))?;
-        let si = surface_integrals(&bd);
+        Ok(Face::build(bd, FaceScattering::Single, None, eta, use_att))
+    }
+
+    /// The front (`back = false`) or back face of `sheet`.
+    pub fn of_sheet(sheet: &Sheet, back: bool, use_att: bool) -> Face {
+        let bd = *sheet.face(back);
+        let coating = if back { None } else { sheet.coating };
+        Face::build(bd, sheet.face_scattering, coating, sheet.eta_medium, use_att)
+    }
+
+    fn build(bd: RoughDielectric, fs: FaceScattering, coating: Option<f64>, n: f64, use_att: bool) -> Face {
+        let ifc = Interface4::new(&bd, fs);
+        let eta = bd.eta;
         let mut f = Face {
             bd,
-            si,
             use_att,
             abar: 1.0,
             att_tab: [0.0; NA],
+            att_dir_tab: [0.0; NA],
             r_tab: [0.0; NA],
-            inv_eta: 1.0 / eta,
+            r_lobes_tab: [0.0; NA],
+            lobes: Vec::new(),
+            rho_in: 0.0,
+            tbar_in: 0.0,
+            iface_k: ifc.k,
+            coating,
+            n,
+            inv_n: 1.0 / n,
+            inv_n2: 1.0 / (n * n),
             inv_eta2: 1.0 / (eta * eta),
+            exact_smooth: matches!(bd.interface, Interface::Smooth) && coating.is_none(),
         };
+        let rough = matches!(bd.interface, Interface::Rough(_));
+        let mut comp_e = [0.0; NA];
+        let mut coat_e = [0.0; NA];
         for k in 0..NA {
             let t = k as f64 / (NA - 1) as f64;
-            f.att_tab[k] = f.si.att(t * t).clamp(0.0, 1.0);
-            f.r_tab[k] = f.si.r_out(t * t).clamp(0.0, 1.0 - f.att_tab[k]);
+            let mu = t * t;
+            let lo = ifc.lost_out(mu);
+            comp_e[k] = lo;
+            let (t_r, t_w) = (ifc.t_out(mu), ifc.t_walter(mu));
+            let r_r = ifc.r_walter(mu) + (1.0 - ifc.k.0) * lo;
+            let (att, att_dir, r_coat) = match coating {
+                None => (t_r, t_w, 0.0),
+                Some(nu) => {
+                    // Inside the coating at the smooth refraction of mu through eta.
+                    let mu_c = refracted_cos(mu, eta).unwrap_or(0.0);
+                    let fs_ = fresnel_dielectric(mu_c, nu);
+                    let denom = 1.0 - fs_ * ifc.r_in(mu_c);
+                    if denom <= 0.0 {
+                        (0.0, 0.0, t_r)
+                    } else {
+                        let g = (1.0 - fs_) / denom;
+                        (t_r * g, t_w * g, t_r * fs_ * ifc.t_in(mu_c) / denom)
+                    }
+                }
+            };
+            f.att_tab[k] = att.clamp(0.0, 1.0);
+            f.att_dir_tab[k] = att_dir.clamp(0.0, f.att_tab[k]);
+            coat_e[k] = r_coat.max(0.0);
+            f.r_tab[k] = (r_r + coat_e[k]).clamp(0.0, 1.0);
         }
+        if rough {
+            if let Some(l) = SeparableLobe::new(comp_e, 1.0 - ifc.k.0) {
+                f.lobes.push(l);
+            }
+            if let Some(l) = SeparableLobe::new(coat_e, 1.0) {
+                f.lobes.push(l);
+            }
+        }
+        for k in 0..NA {
+            f.r_lobes_tab[k] = f.lobes.iter().map(|l| l.albedo_scale * l.e[k]).sum();
+        }
+        // Diffuse light from inside the base.
+        let (rho, tbar) = match coating {
+            None => ifc.hemi_in(),
+            Some(nu) => {
+                // Base cosine mu_b -> coating cosine through the smooth boundary (relative index 1/nu from the base).
+                let one = |mu_b: f64| -> (f64, f64) {
+                    let Some(mu_c) = refracted_cos(mu_b, 1.0 / nu) else {
+                        return (1.0, 0.0);
+                    };
+                    let fs_ = fresnel_dielectric(mu_c, nu);
+                    let r = ifc.r_in(mu_c);
+                    let denom = 1.0 - fs_ * r;
+                    if denom <= 0.0 {
+                        return (1.0, 0.0);
+                    }
+                    (
+                        fs_ + (1.0 - fs_) * (1.0 - fs_) * r / denom,
+                        (1.0 - fs_) * ifc.t_in(mu_c) / denom,
+                    )
+                };
+                // Kinks: TIR at the smooth boundary and at the rough face's critical angle, seen from the base.
+                let mu_k = critical_mu(n / eta.min(n)).max(critical_mu(n));
+                (hemispherical(|m| one(m).0, mu_k), hemispherical(|m| one(m).1, mu_k))
+            }
+        };
+        f.rho_in = rho.clamp(0.0, 1.0);
+        f.tbar_in = tbar.clamp(0.0, 1.0 - f.rho_in);
         if use_att {
-            // mu = t^2 concentrates nodes near grazing where Att changes fastest.
-            static GL: std::sync::OnceLock<(Vec<f64>, Vec<f64>)> = std::sync::OnceLock::new();
-            let (x, w) = GL.get_or_init(|| gauss_legendre_01(24));
-            f.abar = x
-                .iter()
-                .zip(w)
-                .map(|(t, wt)| 2.0 * wt * f.att(t * t) * t * t * 2.0 * t)
-                .sum();
+            f.abar = if f.exact_smooth {
+                hemispherical(|mu| 1.0 - fresnel_dielectric(mu, eta), 0.0)
+            } else {
+                hemispherical_of_table(&f.att_tab)
+            };
         }
-        Ok(f)
+        f
     }
 
-    /// Relative index of the face.
+    /// Index of the base into which the face refracts.
     #[inline]
-    pub fn eta(&self) -> f64 {
-        self.bd.eta
+    pub fn n(&self) -> f64 {
+        self.n
     }
 
-    /// `Att(mu)`: transmittance for light from outside at cosine `mu` (1 when `use_att` is false).
+    /// `Att(mu)`: transmittance into the base, all orders, for light from
+    /// outside at cosine `mu` (1 when `use_att` is false).
     #[inline]
     pub fn att(&self, mu: f64) -> f64 {
         if !self.use_att {
             return 1.0;
         }
-        match self.bd.interface {
-            Interface::IndexMatched => 1.0,
-            Interface::Smooth => 1.0 - fresnel_dielectric(mu.abs(), self.bd.eta),
-            Interface::Rough(_) => lerp_t(&self.att_tab, mu),
+        if self.exact_smooth {
+            return 1.0 - fresnel_dielectric(mu.abs().min(1.0), self.bd.eta);
         }
+        lerp_t(&self.att_tab, mu)
     }
 
-    /// [`Face::att`] at `mu` given also `st = sqrt(min(|mu|, 1))` (saves the
-    /// square root when the caller has it already).
+    /// [`Face::att`] at `mu` given also `st = sqrt(min(|mu|, 1))`.
     #[inline]
-    pub fn att_with_sqrt(&self, mu: f64, st: f64) -> f64 {
+    pub fn att_with_sqrt(&self, st: f64) -> f64 {
         if !self.use_att {
             return 1.0;
         }
-        match self.bd.interface {
-            Interface::IndexMatched => 1.0,
-            Interface::Smooth => 1.0 - fresnel_dielectric(mu.abs(), self.bd.eta),
-            Interface::Rough(_) => lerp_sqrt(&self.att_tab, st),
+        if self.exact_smooth {
+            return 1.0 - fresnel_dielectric(st * st, self.bd.eta);
         }
+        lerp_sqrt(&self.att_tab, st)
     }
 
-    /// [`Face::r_out`] given also `st = sqrt(min(|mu|, 1))`.
+    /// The collimated part of [`Face::att`] (what direct transmission carries), given `st`.
     #[inline]
-    pub fn r_out_with_sqrt(&self, mu: f64, st: f64) -> f64 {
-        match self.bd.interface {
-            Interface::IndexMatched => 0.0,
-            Interface::Smooth => fresnel_dielectric(mu.abs(), self.bd.eta),
-            Interface::Rough(_) => lerp_sqrt(&self.r_tab, st),
+    pub fn att_dir_with_sqrt(&self, st: f64) -> f64 {
+        if !self.use_att {
+            return 1.0;
         }
+        if self.exact_smooth {
+            return 1.0 - fresnel_dielectric(st * st, self.bd.eta);
+        }
+        lerp_sqrt(&self.att_dir_tab, st)
     }
 
-    /// Directional reflectance for light from outside at cosine `mu` (the surface
-    /// reflection's albedo; used as a sampling weight).
+    /// Directional reflectance for light from outside at cosine `mu`, every
+    /// lobe (Walter's, the separable ones, or the delta of a smooth face).
     #[inline]
     pub fn r_out(&self, mu: f64) -> f64 {
-        match self.bd.interface {
+        if self.exact_smooth {
+            return fresnel_dielectric(mu.abs().min(1.0), self.bd.eta);
+        }
+        lerp_t(&self.r_tab, mu)
+    }
+
+    /// [`Face::r_out`] given `st = sqrt(min(|mu|, 1))`.
+    #[inline]
+    pub fn r_out_with_sqrt(&self, st: f64) -> f64 {
+        if self.exact_smooth {
+            return fresnel_dielectric(st * st, self.bd.eta);
+        }
+        lerp_sqrt(&self.r_tab, st)
+    }
+
+    /// Albedo of the separable reflection lobes alone, given `st`.
+    #[inline]
+    pub fn r_lobes_with_sqrt(&self, st: f64) -> f64 {
+        lerp_sqrt(&self.r_lobes_tab, st)
+    }
+
+    /// `rho_in`: hemispherical reflectance for diffuse light from inside the base.
+    #[inline]
+    pub fn rho_in(&self) -> f64 {
+        self.rho_in
+    }
+
+    /// `Tbar_in`: hemispherical transmittance for diffuse light from inside the base.
+    #[inline]
+    pub fn tbar_in(&self) -> f64 {
+        self.tbar_in
+    }
+
+    /// Reflectance from inside the base at base cosine `mu_b` of a face
+    /// without microfacets (smooth or index-matched interface, with its
+    /// coating if any): the internal reflections of unscattered light.
+    pub fn r_in_delta(&self, mu_b: f64) -> f64 {
+        let eta = self.bd.eta;
+        let r_face = |mu_c: f64| match self.bd.interface {
             Interface::IndexMatched => 0.0,
-            Interface::Smooth => fresnel_dielectric(mu.abs(), self.bd.eta),
-            Interface::Rough(_) => lerp_t(&self.r_tab, mu),
+            _ => fresnel_dielectric(-mu_c, eta),
+        };
+        match self.coating {
+            None => r_face(mu_b),
+            Some(nu) => {
+                let Some(mu_c) = refracted_cos(mu_b, 1.0 / nu) else {
+                    return 1.0;
+                };
+                let fs_ = fresnel_dielectric(mu_c, nu);
+                let r = r_face(mu_c);
+                let denom = 1.0 - fs_ * r;
+                if denom <= 0.0 {
+                    1.0
+                } else {
+                    fs_ + (1.0 - fs_) * (1.0 - fs_) * r / denom
+                }
+            }
         }
     }
 
-    /// `rho_in`: hemispherical reflectance for diffuse light from inside.
+    /// Reflectance of a face without microfacets for light from outside at
+    /// `mu` (the weight of its delta reflection, coating included).
     #[inline]
-    pub fn rho_in(&self) -> f64 {
-        self.si.rho_in
+    pub fn delta_reflectance(&self, mu: f64) -> f64 {
+        self.r_out(mu)
     }
 
     /// [`fresnel_dielectric`] for light from outside at cosine `c` in `(0, 1]`
-    /// (`eta >= 1`: no total internal reflection), with the face's `1 / eta^2`
-    /// in place of a division.
+    /// on the rough interface (`eta >= 1`: no total internal reflection), with
+    /// its `1 / eta^2` in place of a division.
     #[inline]
     pub fn fresnel_outside(&self, c: f64) -> f64 {
         if self.bd.eta == 1.0 {
@@ -193,22 +566,22 @@ impl Face {
         crate::fresnel::fresnel_from_cosines(c, cos_t, self.bd.eta)
     }
 
-    /// `1 / eta`.
+    /// `1 / n` of the base.
     #[inline]
-    pub fn inv_eta(&self) -> f64 {
-        self.inv_eta
+    pub fn inv_n(&self) -> f64 {
+        self.inv_n
     }
 
-    /// `1 / eta^2`: the change of radiance on leaving through this face.
+    /// `1 / n^2`: the change of radiance on leaving the base through this face.
     #[inline]
-    pub fn inv_eta2(&self) -> f64 {
-        self.inv_eta2
+    pub fn inv_n2(&self) -> f64 {
+        self.inv_n2
     }
 
-    /// Cosine (magnitude) inside of the smooth refraction of an outside direction with cosine `mu`.
+    /// Cosine (magnitude) in the base of the smooth refraction of an outside direction with cosine `mu`.
     #[inline]
     pub fn inside_cos(&self, mu: f64) -> f64 {
-        (1.0 - (1.0 - mu * mu) * self.inv_eta2).max(0.0).sqrt()
+        (1.0 - (1.0 - mu * mu) * self.inv_n2).max(0.0).sqrt()
     }
 
     /// The microfacet distribution, if rough.
@@ -220,20 +593,35 @@ impl Face {
         }
     }
 
-    /// Whether the face reflects as a delta (smooth, not index-matched).
+    /// Whether the face reflects as a delta (no microfacets, and something reflects).
     #[inline]
     pub fn is_smooth(&self) -> bool {
-        matches!(self.bd.interface, Interface::Smooth)
+        self.microfacet().is_none() && !self.is_index_matched()
     }
 
-    /// Whether there is no interface at all.
+    /// Whether light passes the face without any reflection (index-matched, no coating).
     #[inline]
     pub fn is_index_matched(&self) -> bool {
-        matches!(self.bd.interface, Interface::IndexMatched)
+        matches!(self.bd.interface, Interface::IndexMatched) && self.coating.is_none()
     }
 
-    /// Walter reflection `f_r(wi, wo)` (no cosine) of the face, both directions in
-    /// the face frame on the outside (`z > 0`); zero for a smooth or index-matched face.
+    /// `(k_o, k_i)` of the energy compensation (0 for Walter's faces).
+    pub fn compensation_shares(&self) -> (f64, f64) {
+        self.iface_k
+    }
+
+    /// The separable lobes' reflection `sum_j c_j E_j(mu_i) E_j(mu_o)`, given `st = sqrt(mu)` of both.
+    #[inline]
+    pub fn lobes_reflection(&self, si: f64, so: f64) -> f64 {
+        self.lobes
+            .iter()
+            .map(|l| l.c * lerp_sqrt(&l.e, si) * lerp_sqrt(&l.e, so))
+            .sum()
+    }
+
+    /// Reflection `f_r(wi, wo)` (no cosine) of the face, both directions in
+    /// the face frame on the outside (`z > 0`): Walter's lobe and the
+    /// separable lobes; zero for a face without microfacets (its reflection is a delta).
     #[inline]
     pub fn reflection(&self, wi: DVec3, wo: DVec3) -> f64 {
         let Interface::Rough(mf) = self.bd.interface else {
@@ -242,7 +630,12 @@ impl Face {
         let Some((c2, oh)) = reflection_half(wi, wo) else {
             return 0.0;
         };
-        self.fresnel_outside(oh) * mf.reflection_dg_c2(c2, wi.z, wo.z)
+        let lobes = if self.lobes.is_empty() {
+            0.0
+        } else {
+            self.lobes_reflection(wi.z.min(1.0).sqrt(), wo.z.min(1.0).sqrt())
+        };
+        self.fresnel_outside(oh) * mf.reflection_dg_c2(c2, wi.z, wo.z) + lobes
     }
 
     /// Density of [`Face::sample_reflection`]: `pdf_visible(wo, h) / (4 |wo.h|)`.
@@ -266,7 +659,18 @@ impl Face {
             return (0.0, 0.0);
         };
         let (dg, pdf) = mf.reflection_dg_pdf_c2(c2, wi.z, wo.z);
-        (self.fresnel_outside(oh) * dg, pdf)
+        let lobes = if self.lobes.is_empty() {
+            0.0
+        } else {
+            self.lobes_reflection(wi.z.min(1.0).sqrt(), wo.z.min(1.0).sqrt())
+        };
+        (self.fresnel_outside(oh) * dg + lobes, pdf)
+    }
+
+    /// Walter's reflectance from outside alone (the visible-normal strategy's estimate).
+    #[inline]
+    pub fn r_walter_with_sqrt(&self, st: f64) -> f64 {
+        (self.r_out_with_sqrt(st) - self.r_lobes_with_sqrt(st)).max(0.0)
     }
 
     /// Draws a reflected `wi` (face frame) from the visible normals seen from `wo`.

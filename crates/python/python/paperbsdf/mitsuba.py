@@ -1,0 +1,298 @@
+"""A Mitsuba 3 BSDF plugin ``"paperbsdf"``: the Paper BSDF (and the project's
+other models) in Mitsuba scenes, the way ``roughplastic`` is used.
+
+>>> import mitsuba as mi; mi.set_variant("llvm_ad_rgb")
+>>> import paperbsdf.mitsuba; paperbsdf.mitsuba.register()
+>>> bsdf = mi.load_dict({"type": "paperbsdf", "preset": "matte"})
+
+Properties (scene XML ``<string name=... value=.../>`` or ``load_dict`` keys):
+
+- ``params``: the parameters, inline JSON or a path to a JSON/TOML file
+  (DESIGN.md section 3), or
+- ``preset``: ``matte``, ``luster`` or ``glossy``;
+- ``model``: ``paper`` (default), ``reduced-multilayer``, ``lambert-glass``
+  or ``rough-dielectric``.
+
+Conventions. Mitsuba 3 (radiance transport) gives the BSDF ``si.wi``, the
+direction toward the previous path vertex (the viewer's side), and asks for
+or samples ``wo``, the direction toward the light; its ``eval`` includes the
+cosine ``|cos theta(wo)|`` (Mitsuba's ``diffuse``: ``reflectance / pi *
+cos_theta(wo)``). paperbsdf's ``f(wi, wo)`` has ``wi`` toward the light and
+no cosine. So the plugin evaluates ``f(wi = wo_mitsuba, wo = si.wi) *
+|wo_mitsuba.z|``. Both are in the local frame with +z the front face's
+normal; the sheet is two-sided (light and viewer on either side, reflection
+and transmission). Delta lobes (a smooth face, m = 0, or an index-matched
+one) are returned by ``sample`` as ``DeltaReflection``/``DeltaTransmission``
+with ``pdf`` the lobe's probability; ``eval`` and ``pdf`` exclude them.
+
+Variants. In a scalar variant (``scalar_rgb``) each call is one direction.
+In a JIT variant (``llvm_ad_rgb``) each call hands the whole wavefront to
+Rust (one native call per wavefront, the GIL released, all cores); this
+needs Dr.Jit's *evaluated* loops and calls, which :func:`register` selects
+(``dr.JitFlag.SymbolicLoops`` and ``SymbolicCalls`` off), because a
+recorded (symbolic) kernel cannot call into native code. The model is not
+differentiable: gradients through it are zero.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+
+import paperbsdf as _pb
+
+PLUGIN_NAME = "paperbsdf"
+_PROPERTIES = ("params", "preset", "model")
+
+_registered_variants: set = set()
+
+
+def _np(x) -> np.ndarray:
+    """A Dr.Jit value (scalar or array) as a 1-D float64 numpy array."""
+    return np.atleast_1d(np.asarray(x, dtype=np.float64)).reshape(-1)
+
+
+def _vec_np(v, n: int) -> np.ndarray:
+    """(n, 3) float64 from a Mitsuba Vector3f (scalar or wavefront)."""
+    out = np.empty((n, 3))
+    out[:, 0] = _np(v.x) if n else 0.0
+    out[:, 1] = _np(v.y) if n else 0.0
+    out[:, 2] = _np(v.z) if n else 0.0
+    return out
+
+
+def _size(*vals) -> int:
+    import drjit as dr
+
+    return max(dr.width(v) for v in vals)
+
+
+def _mask_np(active, n: int) -> np.ndarray:
+    a = np.asarray(active, dtype=bool).reshape(-1)
+    if a.size == 1 and n != 1:
+        a = np.full(n, bool(a[0]))
+    return a
+
+
+def _valid_dirs(*ws: np.ndarray) -> np.ndarray:
+    """Rows where every direction is finite and of unit length (to 1e-3:
+    Mitsuba's single-precision directions)."""
+    ok = np.ones(ws[0].shape[0], dtype=bool)
+    for w in ws:
+        with np.errstate(invalid="ignore"):
+            ok &= np.all(np.isfinite(w), axis=1) & (np.abs(np.linalg.norm(w, axis=1) - 1.0) < 1e-3)
+    return ok
+
+
+def _unitise(w: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    w = np.where(ok[:, None], w, np.array([0.0, 0.0, 1.0]))
+    return w / np.linalg.norm(w, axis=1)[:, None]
+
+
+def _aligned(a: np.ndarray, dtype) -> np.ndarray:
+    """A contiguous copy of `a` as `dtype` starting on a 64-byte boundary.
+    Dr.Jit wraps numpy memory without copying and writes the pointer's
+    alignment into the LLVM kernels that read it, so arrays at varying
+    alignments make kernels that miss the kernel cache (and are compiled
+    again, ~0.25 s each); aligned arrays keep every kernel cached."""
+    a = np.asarray(a)
+    item = np.dtype(dtype).itemsize
+    buf = np.empty(a.size + 64 // item, dtype=dtype)
+    off = (-buf.ctypes.data % 64) // item
+    out = buf[off: off + a.size]
+    out[...] = a.reshape(-1)
+    return out
+
+
+def register() -> None:
+    """Registers the BSDF plugin ``"paperbsdf"`` for the current Mitsuba
+    variant (call after ``mi.set_variant``; again after switching variants).
+    In a JIT variant it switches Dr.Jit to evaluated loops and calls (see the
+    module doc)."""
+    import drjit as dr
+    import mitsuba as mi
+
+    variant = mi.variant()
+    if variant is None:
+        raise ValueError("paperbsdf.mitsuba.register(): set a Mitsuba variant first (mi.set_variant)")
+    if dr.is_jit_v(mi.Float):
+        dr.set_flag(dr.JitFlag.SymbolicLoops, False)
+        dr.set_flag(dr.JitFlag.SymbolicCalls, False)
+        dr.set_flag(dr.JitFlag.SymbolicConditionals, False)
+    cls = _make_class(mi, dr)
+    mi.register_bsdf(PLUGIN_NAME, lambda props: cls(props))
+    _registered_variants.add(variant)
+    _wrap_loaders(mi)
+
+
+_VALUE_ERROR = re.compile(r"^ValueError: (.*)$", re.M)
+
+
+def _wrap_loaders(mi) -> None:
+    """Makes ``mi.load_dict``, ``mi.load_string`` and ``mi.load_file`` raise
+    the plugin's ``ValueError`` (a bad property or parameter) as a
+    ``ValueError``: Mitsuba's scene parser turns an exception raised by a
+    Python plugin's constructor into a ``RuntimeError`` carrying its
+    traceback. The message keeps Mitsuba's location ("At dictionary node ...")
+    and the plugin's message. Every other error passes through unchanged.
+    (These loader functions are the same for every variant, so this is done
+    once.)"""
+    for name in ("load_dict", "load_string", "load_file"):
+        orig = getattr(mi, name)
+        if getattr(orig, "_paperbsdf_wrapper", False):
+            continue
+
+        def wrapper(*args, __orig=orig, **kwargs):
+            try:
+                return __orig(*args, **kwargs)
+            except RuntimeError as e:
+                text = str(e)
+                found = _VALUE_ERROR.findall(text) if f'plugin of type "{PLUGIN_NAME}"' in text else []
+                if not found:
+                    raise
+                where = text.split(": failed to instantiate", 1)[0]
+                raise ValueError(f"{where}: {PLUGIN_NAME}: {found[-1]}") from None
+
+        wrapper._paperbsdf_wrapper = True
+        wrapper.__doc__ = getattr(orig, "__doc__", None)
+        wrapper.__name__ = name
+        setattr(mi, name, wrapper)
+
+
+def _make_class(mi, dr):
+    jit = dr.is_jit_v(mi.Float)
+    F = mi.BSDFFlags
+
+    def to_float(a: np.ndarray):
+        return mi.Float(_aligned(a, np.float32)) if jit else float(a[0])
+
+    def to_vec(a: np.ndarray):
+        return mi.Vector3f(to_float(a[:, 0]), to_float(a[:, 1]), to_float(a[:, 2]))
+
+    def to_spec(a: np.ndarray):
+        return mi.Spectrum(to_float(a[:, 0]), to_float(a[:, 1]), to_float(a[:, 2]))
+
+    def to_uint(a: np.ndarray):
+        return mi.UInt32(_aligned(a, np.uint32)) if jit else int(a[0])
+
+    class PaperBsdfPlugin(mi.BSDF):
+        """The paperbsdf model as a Mitsuba BSDF (see the module doc)."""
+
+        def __init__(self, props):
+            mi.BSDF.__init__(self, props)
+            names = [str(k) for k in props.keys()]
+            for k in names:
+                if k not in _PROPERTIES:
+                    raise ValueError(
+                        f"paperbsdf plugin: unknown property `{k}`; known properties: {', '.join(_PROPERTIES)}"
+                    )
+            model = props["model"] if "model" in props else "paper"
+            has_params, has_preset = "params" in props, "preset" in props
+            if has_params and has_preset:
+                raise ValueError("paperbsdf plugin: give either `params` or `preset`, not both")
+            if has_preset:
+                name = props["preset"]
+                if model not in ("paper", "reduced-multilayer"):
+                    raise ValueError(f"paperbsdf plugin: `preset` needs model paper or reduced-multilayer, not `{model}`")
+                params = _pb.preset(name)  # ValueError naming the preset and the known ones
+            elif has_params:
+                params = props["params"]
+                if not isinstance(params, str):
+                    raise ValueError("paperbsdf plugin: property `params` must be a string (inline JSON or a file path)")
+            else:
+                raise ValueError("paperbsdf plugin: give the property `params` (inline JSON or a file) or `preset`")
+            self.model = _pb.Bsdf(model, params)
+            self._source = params if isinstance(params, str) else json.dumps(params)
+            # Lobes: each kind (diffuse, glossy, delta) that the model has, in
+            # reflection and in transmission, on both sides.
+            sides = F.FrontSide | F.BackSide
+            comps = []
+            fl = self.model.flags
+            kinds = []
+            if fl & _pb.FLAG_GLOSSY:
+                kinds.append((_pb.FLAG_GLOSSY, F.GlossyReflection, F.GlossyTransmission))
+            if fl & _pb.FLAG_DIFFUSE:
+                kinds.append((_pb.FLAG_DIFFUSE, F.DiffuseReflection, F.DiffuseTransmission))
+            if fl & _pb.FLAG_SPECULAR:
+                kinds.append((_pb.FLAG_SPECULAR, F.DeltaReflection, F.DeltaTransmission))
+            self._lobe_index = {}
+            for kind, fr, ft in kinds:
+                for side_bit, flag in ((_pb.FLAG_REFLECTION, fr), (_pb.FLAG_TRANSMISSION, ft)):
+                    if fl & side_bit:
+                        self._lobe_index[side_bit | kind] = (len(comps), int(flag))
+                        comps.append(flag | sides)
+            self.m_components = comps
+            flags = F.Empty
+            for c in comps:
+                flags = flags | c
+            self.m_flags = flags
+
+        # --- helpers -------------------------------------------------------
+        def _eval_pdf_np(self, si, wo, active):
+            if jit:
+                dr.eval(si.wi, wo, active)  # one kernel launch for all the inputs
+            n = _size(si.wi, wo, active)
+            wi_v = _vec_np(si.wi, n)  # toward the viewer: paperbsdf's wo
+            wo_l = _vec_np(wo, n)  # toward the light: paperbsdf's wi
+            ok = _mask_np(active, n) & _valid_dirs(wi_v, wo_l)
+            f, pdf = self.model.eval_pdf(_unitise(wo_l, ok), _unitise(wi_v, ok))
+            value = f * np.abs(wo_l[:, 2])[:, None]
+            value[~ok] = 0.0
+            pdf[~ok] = 0.0
+            return value, pdf
+
+        # --- the BSDF interface ---------------------------------------------
+        def eval(self, ctx, si, wo, active=True):
+            value, _ = self._eval_pdf_np(si, wo, active)
+            return to_spec(value)
+
+        def pdf(self, ctx, si, wo, active=True):
+            _, pdf = self._eval_pdf_np(si, wo, active)
+            return to_float(pdf)
+
+        def eval_pdf(self, ctx, si, wo, active=True):
+            value, pdf = self._eval_pdf_np(si, wo, active)
+            return to_spec(value), to_float(pdf)
+
+        def sample(self, ctx, si, sample1, sample2, active=True):
+            if jit:
+                dr.eval(si.wi, sample1, sample2, active)
+            n = _size(si.wi, sample1, sample2.x, active)
+            wi_v = _vec_np(si.wi, n)
+            u = np.empty((n, 3))
+            u[:, 0] = _np(sample1)
+            u[:, 1] = _np(sample2.x)
+            u[:, 2] = _np(sample2.y)
+            ok = _mask_np(active, n) & _valid_dirs(wi_v) & np.all((u >= 0.0) & (u < 1.0), axis=1)
+            u[~ok] = 0.5
+            wi, _f, pdf, flags, weight = self.model.sample_full(_unitise(wi_v, ok), u)
+            ok &= pdf > 0.0
+            weight[~ok] = 0.0
+            pdf[~ok] = 0.0
+            comp = np.zeros(n, dtype=np.uint32)
+            stype = np.zeros(n, dtype=np.uint32)
+            for bits, (idx, flag) in self._lobe_index.items():
+                sel = flags == bits
+                comp[sel] = idx
+                stype[sel] = flag
+            stype[~ok] = 0
+            bs = mi.BSDFSample3f()
+            bs.wo = to_vec(wi)
+            bs.pdf = to_float(pdf)
+            bs.eta = to_float(np.ones(n))  # air on both sides of the sheet
+            bs.sampled_component = to_uint(comp)
+            bs.sampled_type = to_uint(stype)
+            return bs, to_spec(weight)
+
+        def traverse(self, callback):
+            pass
+
+        def parameters_changed(self, keys):
+            pass
+
+        def to_string(self):
+            return f"PaperBsdfPlugin[model={self.model.model!r}, params={self._source!r}]"
+
+    return PaperBsdfPlugin
