@@ -11,6 +11,7 @@ use clap::{Parser, Subcommand};
 mod cmd_convert;
 mod cmd_eval;
 mod cmd_fit;
+mod cmd_measure;
 mod cmd_plot;
 mod cmd_render;
 mod cmd_simulate;
@@ -39,6 +40,12 @@ enum Command {
     Plot(cmd_plot::PlotArgs),
     /// Render a paper scene (a TOML scene file or a built-in scene name).
     Render(cmd_render::RenderArgs),
+    /// Predict what paper makers measure: ISO/TAPPI opacity, ISO brightness, gloss, Kubelka-Munk, scatter distance.
+    Measure(cmd_measure::MeasureArgs),
+    /// Plot the reflected light across a shadow edge (scatter distance, supplement Figure 2).
+    Edge(cmd_measure::EdgeArgs),
+    /// Find Paper BSDF parameters that reproduce a paper datasheet (grammage, caliper, opacity, ...).
+    FromDatasheet(cmd_measure::DatasheetArgs),
 }
 
 /// The error of a run stopped by Ctrl-C after writing what it had (exit code 130).
@@ -89,6 +96,9 @@ fn main() {
         Command::Convert(a) => cmd_convert::run(a),
         Command::Plot(a) => cmd_plot::run(a),
         Command::Render(a) => cmd_render::run(a),
+        Command::Measure(a) => cmd_measure::run_measure(a),
+        Command::Edge(a) => cmd_measure::run_edge(a),
+        Command::FromDatasheet(a) => cmd_measure::run_datasheet(a),
     };
     if let Err(e) = result {
         if let Some(i) = e.downcast_ref::<Interrupted>() {

@@ -27,8 +27,10 @@
 
 pub mod estimate;
 pub mod faces;
+pub mod lateral;
 pub mod slab;
 pub mod walk;
 
 pub use estimate::{simulate_bsdf, simulate_totals, BsdfRun, Estimate, Incidence, SimConfig, SimError, Totals};
+pub use lateral::{simulate_exit_profile, ExitProfile, LateralConfig};
 pub use slab::{Face, Medium, Slab};

@@ -11,7 +11,8 @@
 //! from `sigma_t` (Beer-Lambert), scattering directions from the phase
 //! function. Absorption is implicit (the weight is multiplied by the albedo at
 //! each collision) with Russian roulette below a weight of 0.01. Only depth
-//! matters: the slab is laterally infinite, so lateral position is never tracked.
+//! matters: the slab is laterally infinite; the lateral offset is tracked only
+//! to report where light leaves ([`Tracer::walk_with_exits_at`], for [`crate::lateral`]).
 //!
 //! # Totals
 //! The flux that leaves through the lit face is the reflectance `R`, through the
@@ -675,6 +676,20 @@ impl<'a> Tracer<'a> {
         tally: &mut Tally,
         on_exit: &mut E,
     ) {
+        self.walk_with_exits_at(wi, rng, tally, &mut |w, f, _| on_exit(w, f));
+    }
+
+    /// [`Tracer::walk_with_exits`], also reporting where on the face each exit
+    /// is: `on_exit(direction, flux, xy)` with `xy` the lateral offset (mm) of
+    /// the exit point from the point of entry. Used by [`crate::lateral`].
+    pub fn walk_with_exits_at<R: Rng, E: FnMut(DVec3, f64, glam::DVec2)>(
+        &self,
+        wi: DVec3,
+        rng: &mut R,
+        tally: &mut Tally,
+        on_exit: &mut E,
+    ) {
+        let mut xy = glam::DVec2::ZERO;
         let d = self.slab.d;
         tally.order = 0;
         let lit = Face::lit_by(wi);
@@ -693,7 +708,9 @@ impl<'a> Tracer<'a> {
                 tally.add_f(j, f);
             }
         }
-        let Some((mut dir, mut weight)) = self.surface_vertex(lit, wi_l, 1.0, lit, rng, tally, on_exit) else {
+        let Some((mut dir, mut weight)) =
+            self.surface_vertex(lit, wi_l, 1.0, lit, rng, tally, &mut |w, f| on_exit(w, f, xy))
+        else {
             return;
         };
         let mut z = lit.z(d);
@@ -717,6 +734,7 @@ impl<'a> Tracer<'a> {
             };
             if t < dist {
                 z = (z + t * dir.z).clamp(-d, 0.0);
+                xy += t * dir.truncate();
                 weight *= self.med.albedo;
                 if weight == 0.0 {
                     return;
@@ -756,7 +774,9 @@ impl<'a> Tracer<'a> {
                 dir = new_dir;
             } else {
                 z = x.z(d);
-                match self.surface_vertex(x, x.local(-dir), weight, lit, rng, tally, on_exit) {
+                xy += dist * dir.truncate();
+                let at = xy;
+                match self.surface_vertex(x, x.local(-dir), weight, lit, rng, tally, &mut |w, f| on_exit(w, f, at)) {
                     Some((nd, nw)) => {
                         dir = nd;
                         weight = nw;
