@@ -256,11 +256,26 @@ fn no_albedo_above_one_by_either_integral() {
     // coating is combined over directions, the test bounds how rare and how
     // large the excess is instead of asserting there is none; every sheet
     // without a coating must pass exactly.
-    let uncoated_bad: Vec<&String> = bad.iter().filter(|b| coating_ratio(b).is_none_or(|r| r == 1.0)).collect();
-    assert!(uncoated_bad.is_empty(), "sheets without a coating exceed 1:\n{uncoated_bad:?}");
-    assert!(bad.len() <= 16, "{} violations (more than the 16 the coating defect allows)", bad.len());
+    let uncoated_bad: Vec<&String> = bad
+        .iter()
+        .filter(|b| coating_ratio(b).is_none_or(|r| r == 1.0))
+        .collect();
+    assert!(
+        uncoated_bad.is_empty(),
+        "sheets without a coating exceed 1:\n{uncoated_bad:?}"
+    );
+    assert!(
+        bad.len() <= 16,
+        "{} violations (more than the 16 the coating defect allows)",
+        bad.len()
+    );
     for b in &bad {
-        let a: f64 = b.split("albedo ").nth(1).and_then(|t| t.split(' ').next()).and_then(|t| t.parse().ok()).unwrap_or(9.0);
+        let a: f64 = b
+            .split("albedo ")
+            .nth(1)
+            .and_then(|t| t.split(' ').next())
+            .and_then(|t| t.parse().ok())
+            .unwrap_or(9.0);
         assert!(a < 1.05, "excess above 5%: {b}");
     }
 }
@@ -268,7 +283,13 @@ fn no_albedo_above_one_by_either_integral() {
 /// `eta_f / eta_b` of the `PaperParams` printed in a violation line (`None` for other models).
 fn coating_ratio(line: &str) -> Option<f64> {
     let num = |key: &str| -> Option<f64> {
-        line.split(&format!("{key}: ")).nth(1)?.split(',').next()?.trim().parse().ok()
+        line.split(&format!("{key}: "))
+            .nth(1)?
+            .split(',')
+            .next()?
+            .trim()
+            .parse()
+            .ok()
     };
     Some(num("eta_f")? / num("eta_b")?)
 }

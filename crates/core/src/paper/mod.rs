@@ -1056,8 +1056,8 @@ impl PaperBsdf {
         } else {
             fx.r_out_with_sqrt(st)
         };
-        present[1] = self.lobe_sum > 0.0 && self.albedo.max_channel() > 0.0;
         est[1] = att_o * lerp_tab_sqrt(&self.ess_tab[x], st).mean() * self.kappa;
+        present[1] = self.lobe_sum > 0.0 && self.albedo.max_channel() > 0.0 && est[1] > 1e-12;
         let lobes = fx.r_lobes_with_sqrt(st);
         if self.opts.energy_bound {
             let w = lerp_rgb_sqrt(&self.w_tab[x], st);
@@ -1067,8 +1067,10 @@ impl PaperBsdf {
             est[2] = att_o * self.c_r[x].mean() * PI * fx.abar * self.kappa + lobes;
             est[3] = att_o * self.c_t[x].mean() * PI * fo.abar * self.kappa;
         }
-        present[2] = est[2] > 0.0;
-        present[3] = est[3] > 0.0;
+        // Below 1e-12 of the incident flux a lobe is rounding noise (e.g. a
+        // clear sheet's W = Att - D), not a strategy worth a share of samples.
+        present[2] = est[2] > 1e-12;
+        present[3] = est[3] > 1e-12;
         if self.opts.direct {
             let mu_in = fx.inside_cos(mu).max(1e-6);
             let tm = self.tau.mean();
