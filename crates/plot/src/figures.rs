@@ -75,6 +75,18 @@ fn data_sets(dir: &Path) -> Result<Vec<(String, String, bool)>, String> {
         let mut refs: Vec<PathBuf> = rd
             .filter_map(|e| e.ok().map(|e| e.path()))
             .filter(|p| p.extension().is_some_and(|e| e == "csv"))
+            // Only complete reference sets: those whose header gives the sheet
+            // (`# params:` or `# thickness:`); partial remeasurements such as
+            // `devA_grazing.csv` complete another set and are not fitted alone.
+            .filter(|p| {
+                std::fs::read_to_string(p)
+                    .map(|t| {
+                        t.lines()
+                            .take_while(|l| l.starts_with('#'))
+                            .any(|l| l.starts_with("# params:") || l.starts_with("# thickness:"))
+                    })
+                    .unwrap_or(false)
+            })
             .collect();
         refs.sort();
         for r in refs {
