@@ -116,6 +116,14 @@ pub trait Bsdf: Send + Sync {
 /// (any slab with air on both sides) this is also the fraction of the flux
 /// arriving from `wo` that is reflected and transmitted.
 pub fn sampled_albedo(bsdf: &dyn Bsdf, wo: DVec3, n: usize) -> (Rgb, Rgb) {
+    stratified_albedo(bsdf, wo, n, |s| s.weight())
+}
+
+/// The `n x n` stratified sampling loop of [`sampled_albedo`] and
+/// [`albedo_from`]: draws from [`Bsdf::sample`] started at `w` (lobe choice from
+/// a fixed low-discrepancy offset), weighs each sample with `weight`, and sums
+/// the weights on `w`'s side (reflection) and the other (transmission).
+fn stratified_albedo(bsdf: &dyn Bsdf, w: DVec3, n: usize, weight: impl Fn(&BsdfSample) -> Rgb) -> (Rgb, Rgb) {
     let (mut r, mut t) = (Rgb::ZERO, Rgb::ZERO);
     let inv = 1.0 / n as f64;
     let golden = 0.618_033_988_749_894_9;
@@ -127,15 +135,15 @@ pub fn sampled_albedo(bsdf: &dyn Bsdf, wo: DVec3, n: usize) -> (Rgb, Rgb) {
                 (i as f64 + 0.5) * inv,
                 (j as f64 + (0.5 + k * 0.754_877_666).fract()) * inv,
             ];
-            if let Some(s) = bsdf.sample(wo, uc, [u[0], u[1].min(1.0 - 1e-12)]) {
-                let w = s.weight();
-                if !w.is_finite() {
+            if let Some(s) = bsdf.sample(w, uc, [u[0], u[1].min(1.0 - 1e-12)]) {
+                let v = weight(&s);
+                if !v.is_finite() {
                     continue;
                 }
-                if s.wi.z * wo.z > 0.0 {
-                    r += w;
+                if s.wi.z * w.z > 0.0 {
+                    r += v;
                 } else {
-                    t += w;
+                    t += v;
                 }
             }
         }
@@ -154,34 +162,11 @@ pub fn sampled_albedo(bsdf: &dyn Bsdf, wo: DVec3, n: usize) -> (Rgb, Rgb) {
 /// air are symmetric). Unlike [`sampled_albedo`] it does not rely on the BSDF
 /// being reciprocal.
 pub fn albedo_from(bsdf: &dyn Bsdf, wi: DVec3, n: usize) -> (Rgb, Rgb) {
-    let (mut r, mut t) = (Rgb::ZERO, Rgb::ZERO);
-    let inv = 1.0 / n as f64;
-    let golden = 0.618_033_988_749_894_9;
-    for i in 0..n {
-        for j in 0..n {
-            let k = (i * n + j) as f64;
-            let uc = (0.5 + k * golden).fract();
-            let u = [
-                (i as f64 + 0.5) * inv,
-                (j as f64 + (0.5 + k * 0.754_877_666).fract()) * inv,
-            ];
-            if let Some(s) = bsdf.sample(wi, uc, [u[0], u[1].min(1.0 - 1e-12)]) {
-                let w = if s.flags.is_specular() {
-                    s.weight()
-                } else {
-                    bsdf.eval(wi, s.wi) * (s.wi.z.abs() / s.pdf)
-                };
-                if !w.is_finite() {
-                    continue;
-                }
-                if s.wi.z * wi.z > 0.0 {
-                    r += w;
-                } else {
-                    t += w;
-                }
-            }
+    stratified_albedo(bsdf, wi, n, |s| {
+        if s.flags.is_specular() {
+            s.weight()
+        } else {
+            bsdf.eval(wi, s.wi) * (s.wi.z.abs() / s.pdf)
         }
-    }
-    let norm = inv * inv;
-    (r * norm, t * norm)
+    })
 }
