@@ -17,15 +17,15 @@ use paperbsdf_sim::{simulate_bsdf, SimConfig, Slab};
 pub const PAPERS: [(&str, &str); 3] = [
     (
         "matte",
-        r#"{"d":0.11,"sigma_a":0.4,"sigma_s":140.0,"g_f":0.8,"g_b":-0.35,"w_b":0.2,"eta_f":1.5,"eta_b":1.5,"m_f":0.45,"m_b":0.4,"dist_f":"ggx","dist_b":"ggx"}"#,
+        r#"{"d":0.11,"sigma_a":0.4,"sigma_s":140.0,"g_f":0.8,"g_b":-0.35,"w_b":0.2,"eta_f":1.5,"eta_b":1.5,"m_f":0.45,"m_b":0.4,"dist_f":"ggx","dist_b":"ggx","face_scattering":"multiple"}"#,
     ),
     (
         "luster",
-        r#"{"d":0.24,"sigma_a":0.3,"sigma_s":90.0,"g_f":0.75,"g_b":-0.3,"w_b":0.25,"eta_f":1.55,"eta_b":1.5,"m_f":0.16,"m_b":0.4,"dist_f":"beckmann","dist_b":"ggx"}"#,
+        r#"{"d":0.24,"sigma_a":0.3,"sigma_s":90.0,"g_f":0.75,"g_b":-0.3,"w_b":0.25,"eta_f":1.55,"eta_b":1.5,"m_f":0.16,"m_b":0.4,"dist_f":"beckmann","dist_b":"ggx","face_scattering":"multiple"}"#,
     ),
     (
         "glossy",
-        r#"{"d":0.26,"sigma_a":0.25,"sigma_s":80.0,"g_f":0.7,"g_b":-0.25,"w_b":0.25,"eta_f":1.6,"eta_b":1.5,"m_f":0.06,"m_b":0.4,"dist_f":"beckmann","dist_b":"ggx"}"#,
+        r#"{"d":0.26,"sigma_a":0.25,"sigma_s":80.0,"g_f":0.7,"g_b":-0.25,"w_b":0.25,"eta_f":1.6,"eta_b":1.5,"m_f":0.06,"m_b":0.4,"dist_f":"beckmann","dist_b":"ggx","face_scattering":"multiple"}"#,
     ),
 ];
 
