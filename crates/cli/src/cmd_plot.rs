@@ -31,7 +31,7 @@ pub struct PlotArgs {
     /// Figure title.
     #[arg(long)]
     pub title: Option<String>,
-    /// Fit matte, luster and glossy (and reference/*.csv) in the directory --data-dir with all three models
+    /// Fit matte, luster and glossy (and reference/devA.csv, devB.csv) in the directory --data-dir with all three models
     /// and write fig3_paper, fig4_lambert_glass, fig5_reduced_multilayer (.png, .svg, _log.png) and fit_table.md to --out (default docs).
     #[arg(long)]
     pub figures: bool,

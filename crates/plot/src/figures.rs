@@ -1,6 +1,6 @@
 //! The analogues of the supplement's Figures 3, 4 and 5 and the table of fit
 //! errors: every bundled paper (`matte`, `luster`, `glossy` in the data
-//! directory) and every reference set (`reference/*.csv`) is fitted with each
+//! directory) and the reference sets `reference/devA.csv`, `reference/devB.csv` is fitted with each
 //! of the three models (`paper`, `lambert-glass`, `reduced-multilayer`) on the
 //! incident angles of [`DEFAULT_FIT_THETA_I`]; the other angles are
 //! extrapolation (grey panels). One figure per model, one row per paper.
@@ -42,7 +42,7 @@ pub const FIGURES: [(u32, &str, &str, &str); 3] = [
 /// Settings of [`make_figures`].
 #[derive(Clone, Debug)]
 pub struct FiguresOptions {
-    /// Directory with `matte.csv`, `luster.csv`, `glossy.csv` and optionally `reference/*.csv`.
+    /// Directory with `matte.csv`, `luster.csv`, `glossy.csv` and optionally `reference/devA.csv`, `reference/devB.csv`.
     pub data_dir: PathBuf,
     /// Output directory for the figures and `fit_table.md`.
     pub out_dir: PathBuf,
@@ -61,6 +61,9 @@ pub struct TableRow {
     pub outcome: FitOutcome,
 }
 
+/// The reference sets of `reference/` fitted beside the papers (if present).
+const REFERENCE_SETS: [&str; 2] = ["devA", "devB"];
+
 fn data_sets(dir: &Path) -> Result<Vec<(String, String, bool)>, String> {
     let mut v = Vec::new();
     for p in PAPERS {
@@ -70,16 +73,12 @@ fn data_sets(dir: &Path) -> Result<Vec<(String, String, bool)>, String> {
         }
         v.push((p.to_string(), f.display().to_string(), true));
     }
-    let rd = dir.join("reference");
-    if let Ok(rd) = std::fs::read_dir(&rd) {
-        let mut refs: Vec<PathBuf> = rd
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|e| e == "csv"))
-            .collect();
-        refs.sort();
-        for r in refs {
-            let name = r.file_stem().unwrap().to_string_lossy().to_string();
-            v.push((name, r.display().to_string(), false));
+    // The in-plane brute-force references; the folder also holds the other
+    // reference data of the tests (and devA_grazing.csv etc.), which are not fitted.
+    for name in REFERENCE_SETS {
+        let r = dir.join("reference").join(format!("{name}.csv"));
+        if r.is_file() {
+            v.push((name.to_string(), r.display().to_string(), false));
         }
     }
     Ok(v)

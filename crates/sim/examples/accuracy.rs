@@ -46,7 +46,7 @@ fn paper(name: &str, d: f64, sigma_a: f64, sigma_s: f64, m_f: f64, m_b: f64, dis
 
 fn cases() -> Vec<(String, PaperParams)> {
     let dev = |f: &str| -> PaperParams {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/reference/").to_string() + f;
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/reference/").to_string() + f;
         serde_json::from_str(&std::fs::read_to_string(&path).expect("reference parameters")).expect("valid JSON")
     };
     let mut v: Vec<(String, PaperParams)> = paperbsdf_core::presets::PRESET_NAMES

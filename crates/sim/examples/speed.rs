@@ -15,7 +15,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let name = args.get(1).map(String::as_str).unwrap_or("devA");
     let n: u64 = args.get(2).map(|s| s.parse().unwrap()).unwrap_or(32768);
-    let text = std::fs::read_to_string(format!("../shared/reference/{name}.json")).unwrap();
+    let text = std::fs::read_to_string(format!("data/reference/{name}.json")).unwrap();
     let p: paperbsdf_core::PaperParams = serde_json::from_str(&text).unwrap();
     let slab = Slab::from_params(&p).unwrap();
     let (wi, wo) = in_plane_directions(30.0, 0.0, false);

@@ -1,4 +1,4 @@
-//! The simulator against Mitsuba 3's volumetric path tracer (`../shared/reference/devA.csv`,
+//! The simulator against Mitsuba 3's volumetric path tracer (`data/reference/devA.csv`,
 //! `devB.csv`: brute-force in-plane BSDF of the same physical slab, parameters in
 //! `devA.json`, `devB.json`; produced by `reference/tools/genref.py`).
 //!
