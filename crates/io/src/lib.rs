@@ -15,4 +15,4 @@ pub mod params;
 
 pub use atomic::write_atomic;
 pub use error::DataError;
-pub use params::{load_params, Loaded};
+pub use params::{load_params, read_source_full, Loaded, Source};

@@ -42,6 +42,10 @@ pub const FIGURES: [(u32, &str, &str, &str); 3] = [
 /// Settings of [`make_figures`].
 #[derive(Clone, Debug)]
 pub struct FiguresOptions {
+    /// Arrangement of the panels.
+    pub layout: crate::Layout,
+    /// Size of one panel.
+    pub panel_size: (u32, u32),
     /// Directory with `matte.csv`, `luster.csv`, `glossy.csv` and optionally `reference/devA.csv`, `reference/devB.csv`.
     pub data_dir: PathBuf,
     /// Output directory for the figures and `fit_table.md`.
@@ -126,12 +130,10 @@ pub fn make_figures(opts: &FiguresOptions) -> Result<Vec<TableRow>, String> {
                 outcome: out,
             });
         }
-        let mut fig = Figure {
-            title: format!("{title}; grey: extrapolated incident angles"),
-            rows,
-            log_y: false,
-        };
-        for ext in ["png", "svg"] {
+        let mut fig = Figure::new(format!("{title}; grey: extrapolated incident angles"), rows);
+        fig.layout = opts.layout;
+        fig.panel_size = opts.panel_size;
+        for ext in ["png", "svg", "pdf"] {
             draw_figure(&fig, &opts.out_dir.join(format!("{stem}.{ext}"))).map_err(|e| e.to_string())?;
         }
         fig.log_y = true;
@@ -150,7 +152,7 @@ fn fmt_opt(v: Option<f64>) -> String {
 pub fn table_markdown(rows: &[TableRow], opts: &FiguresOptions) -> String {
     let mut s = String::from("# Fit errors\n\n");
     s += &format!(
-        "Written by `paperbsdf plot --figures --data-dir {} --out {}` (seconds: wall-clock time of each fit). Each data set is fitted on the incident angles {:?} (those it has); \
+        "Written by `paperbsdf plot --figures --data-dir {} --out {}` (the time of each fit is printed, not kept here, so that rerunning leaves this file unchanged). Each data set is fitted on the incident angles {:?} (those it has); \
          the remaining angles are extrapolation. Error: weighted RMS of ln((f_model + e)/(f_meas + e)), e = {}, \
          weights 1/max(stderr/(f_meas + e), {})^2 (crates/fit/src/objective.rs). The bundled sets are simulated \
          (data/README.md); `devA`, `devB` are the independent brute-force references (Mitsuba 3).\n\n",
@@ -160,8 +162,8 @@ pub fn table_markdown(rows: &[TableRow], opts: &FiguresOptions) -> String {
         paperbsdf_fit::objective::LOG_OFFSET,
         paperbsdf_fit::objective::SIGMA_FLOOR
     );
-    s += "| data | model | fitted RMS log error | extrapolation RMS log error | fitted / extrap. points | seconds | distributions |\n";
-    s += "|---|---|---|---|---|---|---|\n";
+    s += "| data | model | fitted RMS log error | extrapolation RMS log error | fitted / extrap. points | distributions |\n";
+    s += "|---|---|---|---|---|---|\n";
     let mut names: Vec<&str> = rows.iter().map(|r| r.data.as_str()).collect();
     names.dedup();
     let mut order: Vec<&str> = Vec::new();
@@ -174,14 +176,13 @@ pub fn table_markdown(rows: &[TableRow], opts: &FiguresOptions) -> String {
         for r in rows.iter().filter(|r| r.data == *n) {
             let o = &r.outcome;
             s += &format!(
-                "| {} | {} | {:.4} | {} | {} / {} | {:.2} | {} |\n",
+                "| {} | {} | {:.4} | {} | {} / {} | {} |\n",
                 r.data,
                 o.model,
                 o.rms_log_error,
                 fmt_opt(o.extrapolation_rms_log_error),
                 o.counts.0,
                 o.counts.1,
-                o.seconds,
                 o.variant
             );
         }
