@@ -44,7 +44,9 @@ pub fn listing(what: &str) -> Result<String> {
     }
     let mut s = String::new();
     if models {
-        s.push_str("models (--model NAME; parameters by name in a JSON/TOML file, inline JSON, a preset or a FIT.json):\n");
+        s.push_str(
+            "models (--model NAME; parameters by name in a JSON/TOML file, inline JSON, a preset or a FIT.json):\n",
+        );
         s.push_str("  paper               the Paper BSDF (Papas, de Mesa, Jensen 2014):\n");
         for (n, r, m) in PAPER_PARAMS {
             s.push_str(&format!("                        {n:<16} {r:<34} {m}\n"));
@@ -54,7 +56,11 @@ pub fn listing(what: &str) -> Result<String> {
         s.push_str("  lambert-glass       Lambert layer under rough glass (the paper's Figure 4 baseline):\n");
         for (n, r, m) in [
             ("k_d", "[0, 1], number or [r,g,b]", "Lambertian reflectance"),
-            ("k_t", "[0, 1], number or [r,g,b]", "Lambertian transmittance (k_d + k_t <= 1)"),
+            (
+                "k_t",
+                "[0, 1], number or [r,g,b]",
+                "Lambertian transmittance (k_d + k_t <= 1)",
+            ),
             ("eta", "[1, 5]", "relative index of the glass faces"),
             ("m", "[0, pi/2]", "roughness of both faces"),
             ("dist", "ggx or beckmann", "microfacet distribution"),
@@ -74,7 +80,9 @@ pub fn listing(what: &str) -> Result<String> {
         if models {
             s.push('\n');
         }
-        s.push_str("paper presets (--params NAME, or `preset = \"NAME\"` in a scene; models paper and reduced-multilayer):\n");
+        s.push_str(
+            "paper presets (--params NAME, or `preset = \"NAME\"` in a scene; models paper and reduced-multilayer):\n",
+        );
         for name in PRESET_NAMES {
             let p = preset(name).expect("listed presets exist");
             let json = serde_json::to_string(&p)?;

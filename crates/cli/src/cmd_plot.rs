@@ -49,7 +49,8 @@ pub struct PlotArgs {
 
 /// Parses `WIDTHxHEIGHT` (each 120 to 2000).
 pub fn parse_panel_size(s: &str) -> Result<(u32, u32)> {
-    let bad = || anyhow!("--panel-size `{s}`: expected WIDTHxHEIGHT, each a whole number from 120 to 2000, e.g. 300x220");
+    let bad =
+        || anyhow!("--panel-size `{s}`: expected WIDTHxHEIGHT, each a whole number from 120 to 2000, e.g. 300x220");
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
     let w: u32 = w.trim().parse().map_err(|_| bad())?;
     let h: u32 = h.trim().parse().map_err(|_| bad())?;
@@ -61,8 +62,8 @@ pub fn parse_panel_size(s: &str) -> Result<(u32, u32)> {
 
 /// Runs `paperbsdf plot`.
 pub fn run(args: PlotArgs) -> Result<()> {
-    let layout = Layout::parse(&args.layout)
-        .ok_or_else(|| anyhow!("--layout `{}`: expected grid or row", args.layout))?;
+    let layout =
+        Layout::parse(&args.layout).ok_or_else(|| anyhow!("--layout `{}`: expected grid or row", args.layout))?;
     let panel_size = parse_panel_size(&args.panel_size)?;
     if args.figures {
         if !args.data.is_empty() || !args.fit.is_empty() {

@@ -58,7 +58,17 @@ fn fit_file_feeds_eval_simulate_and_render() {
     let ev = |p: &str| {
         let (ok, out, err) = run_in(
             dir.path(),
-            &["eval", "--model", "paper", "--params", p, "--theta-i", "45", "--theta-o", "-60:60:30"],
+            &[
+                "eval",
+                "--model",
+                "paper",
+                "--params",
+                p,
+                "--theta-i",
+                "45",
+                "--theta-o",
+                "-60:60:30",
+            ],
         );
         assert!(ok, "{p}: {err}");
         values(&out)
@@ -70,13 +80,36 @@ fn fit_file_feeds_eval_simulate_and_render() {
     // the wrong model for the fit is named
     let (ok, _, err) = run_in(
         dir.path(),
-        &["eval", "--model", "lambert-glass", "--params", "fit.json", "--theta-i", "0", "--theta-o", "0:0:1"],
+        &[
+            "eval",
+            "--model",
+            "lambert-glass",
+            "--params",
+            "fit.json",
+            "--theta-i",
+            "0",
+            "--theta-o",
+            "0:0:1",
+        ],
     );
-    assert!(!ok && err.contains("fit.json") && err.contains("fit of the model `paper`"), "{err}");
+    assert!(
+        !ok && err.contains("fit.json") && err.contains("fit of the model `paper`"),
+        "{err}"
+    );
     // simulate reads it too
     let (ok, out, err) = run_in(
         dir.path(),
-        &["simulate", "--params", "fit.json", "--theta-i", "0", "--theta-o", "0:0:1", "--samples", "4096"],
+        &[
+            "simulate",
+            "--params",
+            "fit.json",
+            "--theta-i",
+            "0",
+            "--theta-o",
+            "0:0:1",
+            "--samples",
+            "4096",
+        ],
     );
     assert!(ok, "{err}");
     assert!(out.lines().any(|l| l.starts_with("R,0,0,")), "{out}");
@@ -100,34 +133,104 @@ fn fit_file_feeds_eval_simulate_and_render() {
 #[test]
 fn presets_by_name() {
     let dir = tempfile::tempdir().unwrap();
-    let lib = paperbsdf_io::models::load_model("paper", &serde_json::to_string(&paperbsdf_core::presets::glossy_photo()).unwrap()).unwrap();
+    let lib = paperbsdf_io::models::load_model(
+        "paper",
+        &serde_json::to_string(&paperbsdf_core::presets::glossy_photo()).unwrap(),
+    )
+    .unwrap();
     let (ok, out, err) = run_in(
         dir.path(),
-        &["eval", "--model", "paper", "--params", "glossy", "--theta-i", "30", "--theta-o", "-30:-30:1"],
+        &[
+            "eval",
+            "--model",
+            "paper",
+            "--params",
+            "glossy",
+            "--theta-i",
+            "30",
+            "--theta-o",
+            "-30:-30:1",
+        ],
     );
     assert!(ok, "{err}");
     assert_eq!(out.lines().next().unwrap(), "kind,theta_i_deg,theta_o_deg,r,g,b");
-    let r_row: Vec<f64> = out.lines().nth(1).unwrap().split(',').skip(3).map(|v| v.parse().unwrap()).collect();
+    let r_row: Vec<f64> = out
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .skip(3)
+        .map(|v| v.parse().unwrap())
+        .collect();
     let (wi, wo) = paperbsdf_core::geometry::in_plane_directions(30.0, -30.0, false);
     let want = lib.model().eval(wi, wo);
     for c in 0..3 {
         assert!((r_row[c] - want.0[c]).abs() <= 1e-8 * want.0[c], "{r_row:?} {want:?}");
     }
-    let (ok, _, err) = run_in(dir.path(), &["albedo", "--model", "reduced-multilayer", "--params", "matte", "--theta-i", "0"]);
+    let (ok, _, err) = run_in(
+        dir.path(),
+        &[
+            "albedo",
+            "--model",
+            "reduced-multilayer",
+            "--params",
+            "matte",
+            "--theta-i",
+            "0",
+        ],
+    );
     assert!(ok, "{err}");
     let (ok, out, err) = run_in(
         dir.path(),
-        &["simulate", "--params", "luster", "--theta-i", "0", "--totals", "--samples", "2048"],
+        &[
+            "simulate",
+            "--params",
+            "luster",
+            "--theta-i",
+            "0",
+            "--totals",
+            "--samples",
+            "2048",
+        ],
     );
     assert!(ok, "{err}");
     assert!(out.lines().count() >= 2, "{out}");
-    let (ok, _, err) = run_in(dir.path(), &["eval", "--model", "paper", "--params", "mate", "--theta-i", "0", "--theta-o", "0:0:1"]);
-    assert!(!ok && err.contains("mate") && err.contains("matte, luster, glossy"), "{err}");
     let (ok, _, err) = run_in(
         dir.path(),
-        &["eval", "--model", "rough-dielectric", "--params", "matte", "--theta-i", "0", "--theta-o", "0:0:1"],
+        &[
+            "eval",
+            "--model",
+            "paper",
+            "--params",
+            "mate",
+            "--theta-i",
+            "0",
+            "--theta-o",
+            "0:0:1",
+        ],
     );
-    assert!(!ok && err.contains("preset `matte`") && err.contains("rough-dielectric"), "{err}");
+    assert!(
+        !ok && err.contains("mate") && err.contains("matte, luster, glossy"),
+        "{err}"
+    );
+    let (ok, _, err) = run_in(
+        dir.path(),
+        &[
+            "eval",
+            "--model",
+            "rough-dielectric",
+            "--params",
+            "matte",
+            "--theta-i",
+            "0",
+            "--theta-o",
+            "0:0:1",
+        ],
+    );
+    assert!(
+        !ok && err.contains("preset `matte`") && err.contains("rough-dielectric"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -135,11 +238,22 @@ fn list_and_help_state_the_conventions() {
     let dir = tempfile::tempdir().unwrap();
     let (ok, out, err) = run_in(dir.path(), &["list"]);
     assert!(ok, "{err}");
-    for w in ["paper", "reduced-multilayer", "lambert-glass", "rough-dielectric", "sigma_s", "k_d", "[0, pi/2]"] {
+    for w in [
+        "paper",
+        "reduced-multilayer",
+        "lambert-glass",
+        "rough-dielectric",
+        "sigma_s",
+        "k_d",
+        "[0, pi/2]",
+    ] {
         assert!(out.contains(w), "{w} missing from\n{out}");
     }
     for name in paperbsdf_core::presets::PRESET_NAMES {
-        let line = out.lines().find(|l| l.trim_start().starts_with(name)).unwrap_or_else(|| panic!("{name}\n{out}"));
+        let line = out
+            .lines()
+            .find(|l| l.trim_start().starts_with(name))
+            .unwrap_or_else(|| panic!("{name}\n{out}"));
         let json = line.trim_start()[name.len()..].trim();
         let p: paperbsdf_core::PaperParams = serde_json::from_str(json).unwrap();
         assert_eq!(p, paperbsdf_core::presets::preset(name).unwrap());
@@ -150,7 +264,9 @@ fn list_and_help_state_the_conventions() {
     assert!(!ok && err.contains("models, presets or all"), "{err}");
     let (ok, out, _) = run_in(dir.path(), &["--help"]);
     assert!(ok);
-    for w in ["+z", "mm", "1/mm", "theta_o", "r,g,b", "sigma_a", "eta_f", "preset", "FIT.json"] {
+    for w in [
+        "+z", "mm", "1/mm", "theta_o", "r,g,b", "sigma_a", "eta_f", "preset", "FIT.json",
+    ] {
         assert!(out.contains(w), "{w} missing from --help:\n{out}");
     }
 }
@@ -162,23 +278,58 @@ fn papercuts() {
     let (ok, out, err) = run_in(
         dir.path(),
         &[
-            "eval", "--model", "rough-dielectric", "--params", r#"{"eta":1.5,"m":0.2,"dist":"ggx"}"#,
-            "--theta-i", "30", "--theta-o", "0:0:1", "--component", "single",
+            "eval",
+            "--model",
+            "rough-dielectric",
+            "--params",
+            r#"{"eta":1.5,"m":0.2,"dist":"ggx"}"#,
+            "--theta-i",
+            "30",
+            "--theta-o",
+            "0:0:1",
+            "--component",
+            "single",
         ],
     );
     assert!(!ok && out.is_empty(), "{out}");
-    assert!(err.contains("single") && err.contains("rough-dielectric") && err.contains("surface"), "{err}");
+    assert!(
+        err.contains("single") && err.contains("rough-dielectric") && err.contains("surface"),
+        "{err}"
+    );
     // an unknown model is blamed on --model, before the parameters are read
     let (ok, _, err) = run_in(
         dir.path(),
-        &["eval", "--model", "lambert", "--params", "matte", "--theta-i", "0", "--theta-o", "0:0:1"],
+        &[
+            "eval",
+            "--model",
+            "lambert",
+            "--params",
+            "matte",
+            "--theta-i",
+            "0",
+            "--theta-o",
+            "0:0:1",
+        ],
     );
-    assert!(!ok && err.contains("--model") && err.contains("unknown model `lambert`"), "{err}");
+    assert!(
+        !ok && err.contains("--model") && err.contains("unknown model `lambert`"),
+        "{err}"
+    );
     assert!(err.contains("lambert-glass"), "{err}");
     // roughness range reads pi/2
     let (ok, _, err) = run_in(
         dir.path(),
-        &["eval", "--model", "rough-dielectric", "--params", r#"{"eta":1.5,"m":2,"dist":"ggx"}"#, "--theta-i", "0", "--theta-o", "0:0:1"],
+        &[
+            "eval",
+            "--model",
+            "rough-dielectric",
+            "--params",
+            r#"{"eta":1.5,"m":2,"dist":"ggx"}"#,
+            "--theta-i",
+            "0",
+            "--theta-o",
+            "0:0:1",
+        ],
     );
     assert!(!ok && err.contains("[0, pi/2]") && !err.contains("1.5707963"), "{err}");
     // plot without --out writes STEM_plot.png in the current directory
@@ -186,16 +337,32 @@ fn papercuts() {
     let (ok, out, err) = run_in(dir.path(), &["plot", data.to_str().unwrap()]);
     assert!(ok, "{err}");
     assert!(out.contains("glossy_plot.png"), "{out}");
-    assert_eq!(&std::fs::read(dir.path().join("glossy_plot.png")).unwrap()[1..4], b"PNG");
+    assert_eq!(
+        &std::fs::read(dir.path().join("glossy_plot.png")).unwrap()[1..4],
+        b"PNG"
+    );
     // PDF output, a layout and a panel size
     let (ok, _, err) = run_in(
         dir.path(),
-        &["plot", data.to_str().unwrap(), "--out", "g.pdf", "--layout", "row", "--panel-size", "200x150", "--log"],
+        &[
+            "plot",
+            data.to_str().unwrap(),
+            "--out",
+            "g.pdf",
+            "--layout",
+            "row",
+            "--panel-size",
+            "200x150",
+            "--log",
+        ],
     );
     assert!(ok, "{err}");
     assert_eq!(&std::fs::read(dir.path().join("g.pdf")).unwrap()[..5], b"%PDF-");
     let (ok, _, err) = run_in(dir.path(), &["plot", data.to_str().unwrap(), "--layout", "diagonal"]);
     assert!(!ok && err.contains("--layout") && err.contains("grid or row"), "{err}");
     let (ok, _, err) = run_in(dir.path(), &["plot", data.to_str().unwrap(), "--panel-size", "20x10"]);
-    assert!(!ok && err.contains("--panel-size") && err.contains("120 to 2000"), "{err}");
+    assert!(
+        !ok && err.contains("--panel-size") && err.contains("120 to 2000"),
+        "{err}"
+    );
 }

@@ -40,7 +40,10 @@ impl Frame {
 struct Lcg(u64);
 impl Lcg {
     fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (self.0 >> 11) as f64 / (1u64 << 53) as f64
     }
 }
@@ -88,11 +91,17 @@ fn main() {
         }
     }
     let (refl, trans) = (refl * (1.0 / n as f64), trans * (1.0 / n as f64));
-    println!("albedo seen from the camera, by sampling ({n} samples): R = {:.4?}, T = {:.4?}", refl.0, trans.0);
+    println!(
+        "albedo seen from the camera, by sampling ({n} samples): R = {:.4?}, T = {:.4?}",
+        refl.0, trans.0
+    );
 
     // The same two numbers by stratified quadrature of the library's own sampler.
     let (r, t) = paperbsdf_core::bsdf::sampled_albedo(&bsdf, wo, 256);
-    println!("                                 by quadrature:         R = {:.4?}, T = {:.4?}", r.0, t.0);
+    println!(
+        "                                 by quadrature:         R = {:.4?}, T = {:.4?}",
+        r.0, t.0
+    );
     for c in 0..3 {
         assert!((refl.0[c] - r.0[c]).abs() < 0.01 && (trans.0[c] - t.0[c]).abs() < 0.01);
     }

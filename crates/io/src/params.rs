@@ -251,7 +251,10 @@ mod tests {
             .to_string();
         assert!(e.contains("/nonexistent/p.json"), "{e}");
         let e = load_params::<PaperParams>("mattte").unwrap_err().to_string();
-        assert!(e.contains("mattte") && e.contains("presets: matte, luster, glossy"), "{e}");
+        assert!(
+            e.contains("mattte") && e.contains("presets: matte, luster, glossy"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -167,7 +167,11 @@ impl Figure {
             }
             Layout::Grid => {
                 // Columns: the incident angles of all rows, so that a column is one angle.
-                let mut thetas: Vec<f64> = self.rows.iter().flat_map(|r| r.panels.iter().map(|p| p.theta_i)).collect();
+                let mut thetas: Vec<f64> = self
+                    .rows
+                    .iter()
+                    .flat_map(|r| r.panels.iter().map(|p| p.theta_i))
+                    .collect();
                 thetas.sort_by(f64::total_cmp);
                 thetas.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
                 for r in &self.rows {
@@ -312,7 +316,11 @@ pub fn tick_label(x: f64, digits: usize) -> String {
         let s = format!("{:.*e}", digits.saturating_sub(1), x);
         // 2.0e-4 -> 2e-4
         let (m, ex) = s.split_once('e').unwrap_or((&s, "0"));
-        let m = if m.contains('.') { m.trim_end_matches('0').trim_end_matches('.') } else { m };
+        let m = if m.contains('.') {
+            m.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            m
+        };
         return format!("{m}e{ex}");
     }
     let d = (digits as i32 - 1 - e).max(0) as usize;
@@ -362,7 +370,11 @@ pub fn linear_ticks(lo: f64, hi: f64, n: usize) -> Vec<f64> {
         return vec![lo];
     }
     let p = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * p).find(|s| *s >= raw).unwrap_or(10.0 * p);
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * p)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * p);
     let first = (lo / step).ceil() as i64;
     let last = (hi / step + 1e-9).floor() as i64;
     (first..=last).map(|k| k as f64 * step).collect()
@@ -469,7 +481,11 @@ where
         panel.theta_i,
         if panel.extrapolated { " (extrapolated)" } else { "" }
     );
-    let y_ticks = if log_y { log_ticks(lo, hi) } else { linear_ticks(lo, hi, 4) };
+    let y_ticks = if log_y {
+        log_ticks(lo, hi)
+    } else {
+        linear_ticks(lo, hi, 4)
+    };
     // Labels of the y ticks: as few significant digits as tell them apart.
     let digits = (1..=4)
         .find(|&d| {
@@ -481,13 +497,8 @@ where
         })
         .unwrap_or(4);
     let y_label = move |v: &f64| tick_label(if log_y { 10f64.powf(*v) } else { *v }, digits);
-    let label_w = y_ticks
-        .iter()
-        .map(|v| y_label(v).chars().count())
-        .max()
-        .unwrap_or(3) as u32
-        * (tick_font * 6 / 10)
-        + 10;
+    let label_w =
+        y_ticks.iter().map(|v| y_label(v).chars().count()).max().unwrap_or(3) as u32 * (tick_font * 6 / 10) + 10;
     let x_keys = vec![-90.0, -60.0, -30.0, 0.0, 30.0, 60.0, 90.0];
     let mut chart = ChartBuilder::on(cell)
         .caption(caption, ("sans-serif", tick_font + 2))
@@ -600,8 +611,18 @@ where
         .iter()
         .flat_map(|r| r.panels.iter().flat_map(|p| p.series.iter()))
     {
-        if !legend.iter().any(|l| l.0 == s.label || (s.label == "measured" && l.0.starts_with("measured"))) {
-            legend.push((if s.label == "measured" && !s.stderr.is_empty() { "measured ± 1 standard error".into() } else { s.label.clone() }, s.colour));
+        if !legend
+            .iter()
+            .any(|l| l.0 == s.label || (s.label == "measured" && l.0.starts_with("measured")))
+        {
+            legend.push((
+                if s.label == "measured" && !s.stderr.is_empty() {
+                    "measured ± 1 standard error".into()
+                } else {
+                    s.label.clone()
+                },
+                s.colour,
+            ));
         }
     }
     legend.push(("extrapolated (not fitted)".into(), (200, 200, 200)));
@@ -637,7 +658,9 @@ where
     let tick_font = (fig.panel_size.1 / 18).clamp(10, 14);
     for ((label, cells), area) in lines.iter().zip(areas) {
         let (label_area, panels_area) = area.split_horizontally(LABEL_W);
-        let style = ("sans-serif", label_font).into_font().transform(FontTransform::Rotate270);
+        let style = ("sans-serif", label_font)
+            .into_font()
+            .transform(FontTransform::Rotate270);
         let (_, h) = label_area.dim_in_pixel();
         let tw = (label_font as f64 * 0.55 * label.chars().count() as f64) as i32;
         label_area
@@ -690,8 +713,12 @@ fn svg_to_pdf(svg: &str, file: &str) -> Result<Vec<u8>, PlotError> {
         message,
     };
     let tree = usvg::Tree::from_str(svg, &opt).map_err(|e| invalid(format!("SVG for PDF: {e}")))?;
-    svg2pdf::to_pdf(&tree, svg2pdf::ConversionOptions::default(), svg2pdf::PageOptions::default())
-        .map_err(|e| invalid(format!("PDF conversion: {e}")))
+    svg2pdf::to_pdf(
+        &tree,
+        svg2pdf::ConversionOptions::default(),
+        svg2pdf::PageOptions::default(),
+    )
+    .map_err(|e| invalid(format!("PDF conversion: {e}")))
 }
 
 /// Draws `fig` to `path`: PNG, SVG or PDF by the file's extension. Atomic: a
@@ -731,7 +758,12 @@ pub fn draw_figure(fig: &Figure, path: &Path) -> Result<(), PlotError> {
         }
         "pdf" => svg_string(fig, &file)
             .and_then(|svg| svg_to_pdf(&svg, &file))
-            .and_then(|pdf| std::fs::write(&tmp, pdf).map_err(|source| PlotError::Io { file: file.clone(), source })),
+            .and_then(|pdf| {
+                std::fs::write(&tmp, pdf).map_err(|source| PlotError::Io {
+                    file: file.clone(),
+                    source,
+                })
+            }),
         _ => {
             return Err(PlotError::Invalid {
                 file,

@@ -159,7 +159,13 @@ fn error_bars_from_stderr() {
     let m = parse_measurement(&text, "t").unwrap();
     let panels = panels_for(&m.points, Some(&Two), None);
     assert_eq!(panels[0].series[0].stderr, vec![0.02; 9]);
-    let fig = Figure::new("bars", vec![Row { label: "x".into(), panels }]);
+    let fig = Figure::new(
+        "bars",
+        vec![Row {
+            label: "x".into(),
+            panels,
+        }],
+    );
     let with = svg_string(&fig, "t.svg").unwrap();
     let mut bare = fig.clone();
     bare.rows[0].panels[0].series[0].stderr.clear();
@@ -177,5 +183,9 @@ fn writes_pdf() {
     let bytes = std::fs::read(&p).unwrap();
     assert_eq!(&bytes[..5], b"%PDF-");
     assert!(bytes.len() > 5000, "{} bytes", bytes.len());
-    assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 1, "no temporary files left");
+    assert_eq!(
+        std::fs::read_dir(d.path()).unwrap().count(),
+        1,
+        "no temporary files left"
+    );
 }

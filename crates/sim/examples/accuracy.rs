@@ -249,16 +249,20 @@ fn plot(path: &str, title: &str, res: &[AngleResult], rgb: bool) -> Result<(), B
             let pts: Vec<&Point> = r.points.iter().filter(|p| p.transmission == t).collect();
             chart
                 .draw_series(LineSeries::new(
-                    pts.iter().map(|p| (p.theta_o, p.model.0[0].max(1e-300).log10().max(lo))),
+                    pts.iter()
+                        .map(|p| (p.theta_o, p.model.0[0].max(1e-300).log10().max(lo))),
                     colour.stroke_width(2),
                 ))?
                 .label(format!("{label} model"))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
             chart
-                .draw_series(
-                    pts.iter()
-                        .map(|p| Circle::new((p.theta_o, p.sim.mean.0[0].max(1e-300).log10().max(lo)), 4, colour.filled())),
-                )?
+                .draw_series(pts.iter().map(|p| {
+                    Circle::new(
+                        (p.theta_o, p.sim.mean.0[0].max(1e-300).log10().max(lo)),
+                        4,
+                        colour.filled(),
+                    )
+                }))?
                 .label(format!("{label} simulation"))
                 .legend(move |(x, y)| Circle::new((x + 10, y), 4, colour.filled()));
             for p in &pts {

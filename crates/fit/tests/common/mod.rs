@@ -10,6 +10,10 @@ pub fn reference(name: &str) -> PathBuf {
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/reference"))
         .join(name);
-    assert!(p.is_file(), "reference data {} is missing (see data/reference/README.md)", p.display());
+    assert!(
+        p.is_file(),
+        "reference data {} is missing (see data/reference/README.md)",
+        p.display()
+    );
     p
 }
