@@ -12,7 +12,7 @@ pub struct EvalArgs {
     /// Model name: rough-dielectric, paper, reduced-multilayer, lambert-glass, or measured (with --params FILE.bsdf, an RGL measured file).
     #[arg(long)]
     pub model: String,
-    /// Parameters: a JSON or TOML file, or inline JSON (`'{"eta":1.5,...}'`); for `measured`, the `.bsdf` file.
+    /// Parameters: a JSON or TOML file, inline JSON (`'{"eta":1.5,...}'`), a FIT.json, or a preset (matte, luster, glossy); for `measured`, the `.bsdf` file.
     #[arg(long)]
     pub params: String,
     /// CSV file of direction pairs (columns wi_x,wi_y,wi_z,wo_x,wo_y,wo_z; others are echoed).
@@ -41,7 +41,7 @@ pub struct AlbedoArgs {
     /// Model name (see `eval`).
     #[arg(long)]
     pub model: String,
-    /// Parameters: a JSON or TOML file, or inline JSON.
+    /// Parameters: a JSON or TOML file, inline JSON, a FIT.json, or a preset (matte, luster, glossy).
     #[arg(long)]
     pub params: String,
     /// Incident polar angles in degrees, comma-separated, in [0, 90).

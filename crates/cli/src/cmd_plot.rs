@@ -8,7 +8,7 @@ use paperbsdf_fit::dataset::load_dataset;
 use paperbsdf_fit::models::build_from_params;
 use paperbsdf_fit::FitOptions;
 use paperbsdf_plot::figures::{make_figures, FiguresOptions, DEFAULT_FIT_THETA_I};
-use paperbsdf_plot::{draw_figure, panels_for, Figure, Row};
+use paperbsdf_plot::{draw_figure, panels_for, Figure, Layout, Row};
 use std::path::PathBuf;
 
 /// Arguments of `paperbsdf plot`.
@@ -19,9 +19,16 @@ pub struct PlotArgs {
     /// FIT.json files written by `paperbsdf fit`: one for all rows, or one per data file.
     #[arg(long)]
     pub fit: Vec<String>,
-    /// Output file (.png or .svg); with --figures, the output directory.
+    /// Output file (.png, .svg or .pdf; default: the first data file's name with `_plot.png`, in the
+    /// current directory); with --figures, the output directory (default docs).
     #[arg(long)]
     pub out: Option<String>,
+    /// Panel layout: grid (per paper, BRDF panels over BTDF panels, one column per incident angle) or row (all in one row).
+    #[arg(long, default_value = "grid")]
+    pub layout: String,
+    /// Size of one panel, WIDTHxHEIGHT in pixels (PNG) or points (SVG, PDF).
+    #[arg(long = "panel-size", default_value = "300x220")]
+    pub panel_size: String,
     /// Logarithmic value axis.
     #[arg(long)]
     pub log: bool,
@@ -31,7 +38,7 @@ pub struct PlotArgs {
     /// Figure title.
     #[arg(long)]
     pub title: Option<String>,
-    /// Fit matte, luster and glossy (and reference/*.csv) in the directory --data-dir with all three models
+    /// Fit matte, luster and glossy (and reference/devA.csv, devB.csv) in the directory --data-dir with all three models
     /// and write fig3_paper, fig4_lambert_glass, fig5_reduced_multilayer (.png, .svg, _log.png) and fit_table.md to --out (default docs).
     #[arg(long)]
     pub figures: bool,
@@ -40,8 +47,24 @@ pub struct PlotArgs {
     pub data_dir: String,
 }
 
+/// Parses `WIDTHxHEIGHT` (each 120 to 2000).
+pub fn parse_panel_size(s: &str) -> Result<(u32, u32)> {
+    let bad =
+        || anyhow!("--panel-size `{s}`: expected WIDTHxHEIGHT, each a whole number from 120 to 2000, e.g. 300x220");
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let w: u32 = w.trim().parse().map_err(|_| bad())?;
+    let h: u32 = h.trim().parse().map_err(|_| bad())?;
+    if !(120..=2000).contains(&w) || !(120..=2000).contains(&h) {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
 /// Runs `paperbsdf plot`.
 pub fn run(args: PlotArgs) -> Result<()> {
+    let layout =
+        Layout::parse(&args.layout).ok_or_else(|| anyhow!("--layout `{}`: expected grid or row", args.layout))?;
+    let panel_size = parse_panel_size(&args.panel_size)?;
     if args.figures {
         if !args.data.is_empty() || !args.fit.is_empty() {
             bail!("--figures takes its data from --data-dir; do not also give data files or --fit");
@@ -59,6 +82,8 @@ pub fn run(args: PlotArgs) -> Result<()> {
                 progress: true,
                 ..Default::default()
             },
+            layout,
+            panel_size,
         };
         let rows = make_figures(&opts).map_err(|e| anyhow!(e))?;
         println!(
@@ -71,10 +96,16 @@ pub fn run(args: PlotArgs) -> Result<()> {
     if args.data.is_empty() {
         bail!("give measurement files to plot (or --figures)");
     }
-    let out = args
-        .out
-        .clone()
-        .ok_or_else(|| anyhow!("--out FILE.png or FILE.svg is required"))?;
+    let out = match &args.out {
+        Some(o) => o.clone(),
+        None => {
+            let stem = std::path::Path::new(&args.data[0])
+                .file_stem()
+                .map(|s| s.to_string_lossy().to_string())
+                .unwrap_or_else(|| "plot".into());
+            format!("{stem}_plot.png")
+        }
+    };
     paperbsdf_io::check_output_path(&out, "--out")?;
     if !(args.fit.is_empty() || args.fit.len() == 1 || args.fit.len() == args.data.len()) {
         bail!(
@@ -113,11 +144,10 @@ pub fn run(args: PlotArgs) -> Result<()> {
         }
         rows.push(Row { label, panels });
     }
-    let fig = Figure {
-        title: args.title.unwrap_or_else(|| "in-plane BSDF".into()),
-        rows,
-        log_y: args.log,
-    };
+    let mut fig = Figure::new(args.title.unwrap_or_else(|| "in-plane BSDF".into()), rows);
+    fig.log_y = args.log;
+    fig.layout = layout;
+    fig.panel_size = panel_size;
     draw_figure(&fig, std::path::Path::new(&out))?;
     println!("wrote {out}");
     Ok(())

@@ -12,7 +12,7 @@ use paperbsdf_sim::{simulate_bsdf, simulate_totals, Estimate, Incidence, SimConf
 /// Arguments of `paperbsdf simulate`.
 #[derive(clap::Args, Debug)]
 pub struct SimulateArgs {
-    /// Paper parameters: a JSON or TOML file, or inline JSON.
+    /// Paper parameters: a JSON or TOML file, inline JSON, a FIT.json, or a preset (matte, luster, glossy).
     #[arg(long)]
     pub params: String,
     /// In-plane incident angles in degrees, comma-separated, in [0, 90).

@@ -11,14 +11,33 @@ use clap::{Parser, Subcommand};
 mod cmd_convert;
 mod cmd_eval;
 mod cmd_fit;
+mod cmd_list;
 mod cmd_measure;
 mod cmd_plot;
 mod cmd_render;
 mod cmd_simulate;
 
+/// The conventions every subcommand follows, printed by `paperbsdf --help`.
+const CONVENTIONS: &str = "\
+Conventions:
+  frame     local frame, +z the normal of the front face (z = 0); the back face is z = -d.
+            f(wi, wo) is the BSDF without the cosine; wi points toward the light, wo toward
+            the viewer (unit vectors). Reflection: wi.z, wo.z of one sign; transmission: opposite.
+  in-plane  light at theta_i (degrees, 0..90) in the x-z plane on the +x side; theta_o signed,
+            positive on the light's side. R rows look from z > 0, T rows from z < 0 with
+            theta_o measured from -z (straight through at theta_i = 30 is T, theta_o = -30).
+  units     lengths in mm (d), coefficients in 1/mm (sigma_a, sigma_s), angles in degrees.
+  params    --params FILE.json|FILE.toml, inline JSON '{...}', a FIT.json of `paperbsdf fit`,
+            or a preset name (matte, luster, glossy). Paper parameters: d, sigma_a, sigma_s,
+            g_f, g_b, w_b, eta_f, eta_b, m_f, m_b, dist_f, dist_b [, face_scattering, name];
+            `paperbsdf list` prints every model's parameters and ranges and the presets.
+  output    eval: kind,theta_i_deg,theta_o_deg,f (or the --dirs columns then f); the value
+            column f becomes r,g,b when sigma_a or sigma_s (k_d, k_t) is an RGB triple.
+            simulate adds stderr; albedo prints theta_i_deg,reflectance,transmittance.";
+
 /// The Paper BSDF (Papas, de Mesa, Jensen, EGSR 2014): evaluate, simulate, fit, plot, render.
 #[derive(Parser, Debug)]
-#[command(name = "paperbsdf", version, about, long_about = None)]
+#[command(name = "paperbsdf", version, about, long_about = None, after_help = CONVENTIONS)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -46,6 +65,8 @@ enum Command {
     Edge(cmd_measure::EdgeArgs),
     /// Find Paper BSDF parameters that reproduce a paper datasheet (grammage, caliper, opacity, ...).
     FromDatasheet(cmd_measure::DatasheetArgs),
+    /// List the models with their parameters and the paper presets with their values.
+    List(cmd_list::ListArgs),
 }
 
 /// The error of a run stopped by Ctrl-C after writing what it had (exit code 130).
@@ -99,6 +120,7 @@ fn main() {
         Command::Measure(a) => cmd_measure::run_measure(a),
         Command::Edge(a) => cmd_measure::run_edge(a),
         Command::FromDatasheet(a) => cmd_measure::run_datasheet(a),
+        Command::List(a) => cmd_list::run(a),
     };
     if let Err(e) = result {
         if let Some(i) = e.downcast_ref::<Interrupted>() {

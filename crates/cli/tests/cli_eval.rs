@@ -3,6 +3,8 @@
 
 use std::process::Command;
 
+mod common;
+
 fn run(args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_paperbsdf"))
         .args(args)
@@ -296,7 +298,8 @@ fn out_file_is_written_atomically() {
 /// r,g,b columns, and the paper parameter file's errors name the key.
 #[test]
 fn paper_models_and_components() {
-    let dev_a = "../shared/reference/devA.json";
+    let dev_a_path = common::reference("devA.json");
+    let dev_a = dev_a_path.to_str().unwrap();
     let get = |model: &str, params: &str, comp: &str| -> Vec<Vec<f64>> {
         let (ok, out, err) = run(&[
             "eval",
@@ -347,12 +350,9 @@ fn paper_models_and_components() {
     ]);
     assert!(ok, "{err}");
     assert_eq!(out.lines().next().unwrap(), "kind,theta_i_deg,theta_o_deg,r,g,b");
-    let bad = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/reference/devA.json"
-    ))
-    .unwrap()
-    .replace("\"g_b\"", "\"gb\"");
+    let bad = std::fs::read_to_string(&dev_a_path)
+        .unwrap()
+        .replace("\"g_b\"", "\"gb\"");
     let (ok, _, err) = run(&[
         "eval",
         "--model",

@@ -7,7 +7,11 @@
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParamError {
     /// A number outside its allowed closed range.
-    #[error("parameter `{name}` = {value} is outside its allowed range [{min}, {max}]")]
+    #[error(
+        "parameter `{name}` = {value} is outside its allowed range [{}, {}]",
+        fmt_bound(*min),
+        fmt_bound(*max)
+    )]
     OutOfRange {
         /// Parameter name as in parameter files.
         name: String,
@@ -34,6 +38,17 @@ pub enum ParamError {
         /// What is wrong.
         message: String,
     },
+}
+
+/// A range bound as people write it: `pi/2` for the roughness limit, `inf`, else the number.
+fn fmt_bound(x: f64) -> String {
+    if (x - std::f64::consts::FRAC_PI_2).abs() < 1e-12 {
+        "pi/2".to_string()
+    } else if x.is_infinite() {
+        if x > 0.0 { "inf" } else { "-inf" }.to_string()
+    } else {
+        x.to_string()
+    }
 }
 
 impl ParamError {

@@ -3,18 +3,24 @@
 
 use std::path::PathBuf;
 
-/// `../shared/reference` beside the repository (as in CI), or `$PAPERBSDF_SHARED/reference`.
+/// The in-repository copy of the independent reference data, `data/reference`
+/// (see its README for provenance), or `$PAPERBSDF_REFERENCE` if set.
 pub fn reference_dir() -> PathBuf {
-    let shared = std::env::var_os("PAPERBSDF_SHARED")
+    std::env::var_os("PAPERBSDF_REFERENCE")
         .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
-    shared.join("reference")
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/reference"))
+}
+
+/// The text of a reference file; a missing file panics with its full path.
+pub fn read_text(name: &str) -> String {
+    let path = reference_dir().join(name);
+    std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("reference data {}: {e} (see data/reference/README.md)", path.display()))
 }
 
 /// Rows of a CSV file with `#` comment lines, as header -> value maps.
 pub fn read_csv(name: &str) -> Vec<std::collections::HashMap<String, String>> {
-    let path = reference_dir().join(name);
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    let text = read_text(name);
     let mut lines = text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty());
     let header: Vec<String> = lines
         .next()

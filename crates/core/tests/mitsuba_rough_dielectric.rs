@@ -1,5 +1,5 @@
 //! The rough dielectric against Mitsuba 3's `roughdielectric`
-//! (../shared/reference/rough_dev_eval.csv and rough_dev_albedo.csv).
+//! (data/reference/rough_dev_eval.csv and rough_dev_albedo.csv).
 
 mod common;
 use paperbsdf_core::{Bsdf, DVec3, Distribution, RoughDielectric, TransportMode};

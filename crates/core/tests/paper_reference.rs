@@ -14,7 +14,7 @@ use paperbsdf_core::paper::PaperBsdf;
 use paperbsdf_core::{Bsdf, PaperParams};
 
 fn rms_log_error(dev: &str) -> f64 {
-    let txt = std::fs::read_to_string(common::reference_dir().join(format!("{dev}.json"))).unwrap();
+    let txt = common::read_text(&format!("{dev}.json"));
     let mut p: PaperParams = serde_json::from_str(&txt).unwrap();
     // The references were made with Walter's faces (Mitsuba's roughdielectric).
     p.face_scattering = paperbsdf_core::FaceScattering::Single;

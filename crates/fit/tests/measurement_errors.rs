@@ -3,6 +3,8 @@
 
 use paperbsdf_fit::{parse_measurement, read_measurement, Kind};
 
+mod common;
+
 fn err(text: &str) -> String {
     parse_measurement(text, "m.csv").unwrap_err().to_string()
 }
@@ -87,11 +89,8 @@ fn general_layout() {
 #[test]
 fn reference_files_read_with_thickness_from_header() {
     for (f, d) in [("devA.csv", 0.1), ("devB.csv", 0.25)] {
-        let p = format!("{}/../../../shared/reference/{f}", env!("CARGO_MANIFEST_DIR"));
-        let Ok(m) = read_measurement(&p) else {
-            eprintln!("skipping: {p} not present");
-            continue;
-        };
+        let p = common::reference(f);
+        let m = read_measurement(p.to_str().unwrap()).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(m.thickness, Some(d));
         assert_eq!(m.points.len(), 72);
         assert!(m.points.iter().all(|p| p.stderr.is_some()));

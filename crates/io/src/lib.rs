@@ -18,5 +18,5 @@ pub mod text;
 
 pub use atomic::{check_output_path, write_atomic};
 pub use error::DataError;
-pub use params::{load_params, Loaded};
+pub use params::{load_params, read_source_full, Loaded, Source};
 pub use rgl::MeasuredBsdf;

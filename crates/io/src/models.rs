@@ -4,7 +4,7 @@
 //! `rough-dielectric`; and `measured`, whose "parameters" are a measured
 //! RGL `.bsdf` file ([`crate::rgl`]).
 
-use crate::params::{parse_text, read_source, Loaded};
+use crate::params::{parse_text, read_source_full, Loaded};
 use crate::DataError;
 use paperbsdf_core::models::{ComponentModel, LambertGlass, LambertGlassParams, MODEL_NAMES};
 use paperbsdf_core::paper::{Component, PaperBsdf};
@@ -22,13 +22,39 @@ pub enum LoadedModel {
     Measured(Box<crate::MeasuredBsdf>),
 }
 
-/// Loads model `name` with parameters from `source` (file path or inline JSON).
+/// Loads model `name` with parameters from `source` (file path, inline JSON, a
+/// paper preset name or a FIT.json; see [`crate::params`]). The model name is
+/// checked first, then that a FIT.json holds a fit of this model and that a
+/// preset is used with a slab model.
 pub fn load_model(name: &str, source: &str) -> Result<LoadedModel, DataError> {
     if name == "measured" {
         return Ok(LoadedModel::Measured(Box::new(crate::MeasuredBsdf::load(source)?)));
     }
-    let (text, origin, is_toml) = read_source(source)?;
-    load_model_text(name, &text, &origin, is_toml)
+    if !MODEL_NAMES.contains(&name) {
+        return Err(DataError::Other {
+            file: "--model".to_string(),
+            message: format!("unknown model `{name}`; known models: {}", MODEL_NAMES.join(", ")),
+        });
+    }
+    let s = read_source_full(source)?;
+    let slab = matches!(name, "paper" | "reduced-multilayer");
+    if let Some(fit) = &s.fit_model {
+        if fit != name {
+            return Err(DataError::Other {
+                file: s.origin,
+                message: format!("this is a fit of the model `{fit}`, not `{name}`: use --model {fit}"),
+            });
+        }
+    }
+    if s.preset.is_some() && !slab {
+        return Err(DataError::Other {
+            file: s.origin,
+            message: format!(
+                "presets are Paper BSDF parameters (models paper, reduced-multilayer), not `{name}` parameters"
+            ),
+        });
+    }
+    load_model_text(name, &s.text, &s.origin, s.is_toml)
 }
 
 /// Builds model `name` from the text of a parameter set (JSON, or TOML when
@@ -92,13 +118,28 @@ impl LoadedModel {
         self.model().is_rgb()
     }
 
-    /// `f(wi, wo)` of one component (`surface`, `single`, `multiple`, `direct`) or `all`.
+    /// `f(wi, wo)` of one component (`surface`, `single`, `multiple`, `direct`) or `all`;
+    /// a component the model does not have is an error (not a silent zero).
     pub fn eval_component(&self, wi: DVec3, wo: DVec3, component: &str) -> Result<Rgb, String> {
         if component == "all" {
             return Ok(self.model().eval(wi, wo));
         }
         match Component::parse(component) {
-            Some(c) => Ok(self.model().eval_component(wi, wo, c)),
+            Some(c) if self.model().components().contains(&c) => Ok(self.model().eval_component(wi, wo, c)),
+            Some(c) => {
+                let name = match self {
+                    LoadedModel::Paper(_) => "this paper model",
+                    LoadedModel::LambertGlass(_) => "the model lambert-glass",
+                    LoadedModel::RoughDielectric(_) => "the model rough-dielectric",
+                    LoadedModel::Measured(_) => "the measured BSDF",
+                };
+                let has: Vec<&str> = self.model().components().iter().map(|c| c.name()).collect();
+                Err(format!(
+                    "--component {}: {name} has no such component (it has: {}, all)",
+                    c.name(),
+                    has.join(", ")
+                ))
+            }
             None => Err(format!(
                 "unknown component `{component}`: expected surface, single, multiple, direct or all"
             )),

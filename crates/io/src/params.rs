@@ -1,7 +1,11 @@
-//! Parameter files: a path to a JSON or TOML file, or inline JSON (a string
-//! starting with `{`). Keys are exactly the parameter names of DESIGN.md
-//! section 3 (unknown keys are errors, which catches typos); values outside
-//! their ranges are errors naming the file, line, parameter, value and range.
+//! Parameter files: a path to a JSON or TOML file, inline JSON (a string
+//! starting with `{`), the name of a paper preset (`matte`, `luster`, `glossy`,
+//! see [`paperbsdf_core::presets`]) when no file of that name exists, or a
+//! FIT.json written by `paperbsdf fit` (its `params` object is used, and error
+//! lines still point into the fit file). Keys are exactly the parameter names
+//! of DESIGN.md section 3 (unknown keys are errors, which catches typos);
+//! values outside their ranges are errors naming the file, line, parameter,
+//! value and range.
 
 use crate::DataError;
 use paperbsdf_core::ParamError;
@@ -52,15 +56,105 @@ pub fn locate_key(text: &str, key: &str, is_toml: bool) -> usize {
     0
 }
 
-/// Reads `source` (a path, or inline JSON starting with `{`) as the text of a parameter set.
-pub fn read_source(source: &str) -> Result<(String, String, bool), DataError> {
+/// A parameter source read into text: what [`read_source_full`] returns.
+#[derive(Debug, Clone)]
+pub struct Source {
+    /// The text of the parameter set (for a FIT.json: the file with everything
+    /// but its `params` object blanked, so line numbers stay those of the file).
+    pub text: String,
+    /// File name, `<inline>`, or `preset `NAME``.
+    pub origin: String,
+    /// Whether the text is TOML (else JSON).
+    pub is_toml: bool,
+    /// The model of a FIT.json (`paper`, `lambert-glass`, ...), if the source is one.
+    pub fit_model: Option<String>,
+    /// The preset name, if the source is one.
+    pub preset: Option<String>,
+}
+
+/// The top-level keys of a FIT.json that identify it (see `paperbsdf fit --out`).
+#[derive(serde::Deserialize)]
+struct FitFile<'a> {
+    model: String,
+    #[serde(borrow)]
+    params: &'a serde_json::value::RawValue,
+}
+
+/// If `text` is a FIT.json, its model and `text` with everything outside the
+/// `params` object replaced by spaces (newlines kept): still valid JSON, the
+/// parameters, with line and column numbers those of the fit file.
+fn fit_params(text: &str) -> Option<(String, String)> {
+    let fit: FitFile = serde_json::from_str(text).ok()?;
+    let raw = fit.params.get();
+    let start = (raw.as_ptr() as usize).checked_sub(text.as_ptr() as usize)?;
+    let end = start + raw.len();
+    if end > text.len() {
+        return None;
+    }
+    let blank = |s: &str| -> String { s.chars().map(|c| if c == '\n' { '\n' } else { ' ' }).collect() };
+    Some((fit.model, blank(&text[..start]) + raw + &blank(&text[end..])))
+}
+
+/// Reads `source` (a path, inline JSON starting with `{`, a preset name or a
+/// FIT.json; see the module doc) as the text of a parameter set.
+pub fn read_source_full(source: &str) -> Result<Source, DataError> {
     let s = source.trim_start();
     if s.starts_with('{') {
-        return Ok((source.to_string(), "<inline>".to_string(), false));
+        return Ok(Source {
+            text: source.to_string(),
+            origin: "<inline>".to_string(),
+            is_toml: false,
+            fit_model: None,
+            preset: None,
+        });
     }
-    let text = crate::text::read_text(source)?;
+    if !std::path::Path::new(source).exists() {
+        if let Some(p) = paperbsdf_core::presets::preset(source) {
+            let text = serde_json::to_string_pretty(&p).expect("presets serialise") + "\n";
+            return Ok(Source {
+                text,
+                origin: format!("preset `{source}`"),
+                is_toml: false,
+                fit_model: None,
+                preset: Some(source.to_string()),
+            });
+        }
+    }
+    let text = crate::text::read_text(source).map_err(|e| match e {
+        DataError::Io { source: io, .. } if !source.contains(['/', '\\', '.']) => DataError::Io {
+            file: format!(
+                "{source} (neither a file nor a preset; presets: {})",
+                paperbsdf_core::presets::PRESET_NAMES.join(", ")
+            ),
+            source: io,
+        },
+        other => other,
+    })?;
     let is_toml = source.to_ascii_lowercase().ends_with(".toml");
-    Ok((text, source.to_string(), is_toml))
+    if !is_toml {
+        if let Some((model, params)) = fit_params(&text) {
+            return Ok(Source {
+                text: params,
+                origin: source.to_string(),
+                is_toml,
+                fit_model: Some(model),
+                preset: None,
+            });
+        }
+    }
+    Ok(Source {
+        text,
+        origin: source.to_string(),
+        is_toml,
+        fit_model: None,
+        preset: None,
+    })
+}
+
+/// Reads `source` as the text of a parameter set: `(text, origin, is_toml)` of [`read_source_full`].
+pub fn read_source(source: &str) -> Result<(String, String, bool), DataError> {
+    let s = read_source_full(source)?;
+    Ok((s.text, s.origin, s.is_toml))
 }
 
 /// The key whose value is being read at byte `offset` of `text`: the last
@@ -268,5 +362,49 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("/nonexistent/p.json"), "{e}");
+        let e = load_params::<PaperParams>("mattte").unwrap_err().to_string();
+        assert!(
+            e.contains("mattte") && e.contains("presets: matte, luster, glossy"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn preset_by_name() {
+        let l = load_params::<PaperParams>("glossy").unwrap();
+        assert_eq!(l.value, paperbsdf_core::presets::glossy_photo());
+        assert_eq!(l.origin, "preset `glossy`");
+        let s = read_source_full("Matte").unwrap();
+        assert_eq!(s.preset.as_deref(), Some("Matte"));
+    }
+
+    /// A FIT.json as `paperbsdf fit --out` writes it: the `params` object is
+    /// read, and an error in it names the fit file's own line.
+    #[test]
+    fn fit_file_params() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("fit.json");
+        let params: serde_json::Value = serde_json::from_str(GOOD).unwrap();
+        let fit = serde_json::json!({"model": "paper", "params": params, "rms_log_error": 0.02,
+            "data": ["m.csv"], "errors": [{"kind": "R", "theta_i": 0.0}]});
+        let text = serde_json::to_string_pretty(&fit).unwrap();
+        std::fs::write(&path, &text).unwrap();
+        let p = path.to_str().unwrap();
+        let l = load_params::<PaperParams>(p).unwrap();
+        assert_eq!(l.value, load_params::<PaperParams>(GOOD).unwrap().value);
+        assert_eq!(read_source_full(p).unwrap().fit_model.as_deref(), Some("paper"));
+        // an out-of-range value: the line is that of `w_b` in the fit file
+        let bad = text.replace("\"w_b\": 0.15", "\"w_b\": 1.15");
+        let line = bad.lines().position(|l| l.contains("\"w_b\"")).unwrap() + 1;
+        std::fs::write(&path, &bad).unwrap();
+        let l = load_params::<PaperParams>(p).unwrap();
+        let e = l.param_error(l.value.validate().unwrap_err()).to_string();
+        assert!(e.starts_with(&format!("{p}:{line}:")) && e.contains("w_b"), "{e}");
+        // an unknown key inside params: syntax error at its line in the fit file
+        let bad = text.replace("\"g_b\"", "\"gb\"");
+        let line = bad.lines().position(|l| l.contains("\"gb\"")).unwrap() + 1;
+        std::fs::write(&path, &bad).unwrap();
+        let e = load_params::<PaperParams>(p).unwrap_err().to_string();
+        assert!(e.starts_with(&format!("{p}:{line}:")) && e.contains("gb"), "{e}");
     }
 }

@@ -1,6 +1,6 @@
 //! The analogues of the supplement's Figures 3, 4 and 5 and the table of fit
 //! errors: every bundled paper (`matte`, `luster`, `glossy` in the data
-//! directory) and every reference set (`reference/*.csv`) is fitted with each
+//! directory) and the reference sets `reference/devA.csv`, `reference/devB.csv` is fitted with each
 //! of the three models (`paper`, `lambert-glass`, `reduced-multilayer`) on the
 //! incident angles of [`DEFAULT_FIT_THETA_I`]; the other angles are
 //! extrapolation (grey panels). One figure per model, one row per paper.
@@ -42,7 +42,11 @@ pub const FIGURES: [(u32, &str, &str, &str); 3] = [
 /// Settings of [`make_figures`].
 #[derive(Clone, Debug)]
 pub struct FiguresOptions {
-    /// Directory with `matte.csv`, `luster.csv`, `glossy.csv` and optionally `reference/*.csv`.
+    /// Arrangement of the panels.
+    pub layout: crate::Layout,
+    /// Size of one panel.
+    pub panel_size: (u32, u32),
+    /// Directory with `matte.csv`, `luster.csv`, `glossy.csv` and optionally `reference/devA.csv`, `reference/devB.csv`.
     pub data_dir: PathBuf,
     /// Output directory for the figures and `fit_table.md`.
     pub out_dir: PathBuf,
@@ -61,6 +65,9 @@ pub struct TableRow {
     pub outcome: FitOutcome,
 }
 
+/// The reference sets of `reference/` fitted beside the papers (if present).
+const REFERENCE_SETS: [&str; 2] = ["devA", "devB"];
+
 fn data_sets(dir: &Path) -> Result<Vec<(String, String, bool)>, String> {
     let mut v = Vec::new();
     for p in PAPERS {
@@ -70,28 +77,12 @@ fn data_sets(dir: &Path) -> Result<Vec<(String, String, bool)>, String> {
         }
         v.push((p.to_string(), f.display().to_string(), true));
     }
-    let rd = dir.join("reference");
-    if let Ok(rd) = std::fs::read_dir(&rd) {
-        let mut refs: Vec<PathBuf> = rd
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|e| e == "csv"))
-            // Only complete reference sets: those whose header gives the sheet
-            // (`# params:` or `# thickness:`); partial remeasurements such as
-            // `devA_grazing.csv` complete another set and are not fitted alone.
-            .filter(|p| {
-                std::fs::read_to_string(p)
-                    .map(|t| {
-                        t.lines()
-                            .take_while(|l| l.starts_with('#'))
-                            .any(|l| l.starts_with("# params:") || l.starts_with("# thickness:"))
-                    })
-                    .unwrap_or(false)
-            })
-            .collect();
-        refs.sort();
-        for r in refs {
-            let name = r.file_stem().unwrap().to_string_lossy().to_string();
-            v.push((name, r.display().to_string(), false));
+    // The in-plane brute-force references; the folder also holds the other
+    // reference data of the tests (and devA_grazing.csv etc.), which are not fitted.
+    for name in REFERENCE_SETS {
+        let r = dir.join("reference").join(format!("{name}.csv"));
+        if r.is_file() {
+            v.push((name.to_string(), r.display().to_string(), false));
         }
     }
     Ok(v)
@@ -139,12 +130,10 @@ pub fn make_figures(opts: &FiguresOptions) -> Result<Vec<TableRow>, String> {
                 outcome: out,
             });
         }
-        let mut fig = Figure {
-            title: format!("{title}; grey: extrapolated incident angles"),
-            rows,
-            log_y: false,
-        };
-        for ext in ["png", "svg"] {
+        let mut fig = Figure::new(format!("{title}; grey: extrapolated incident angles"), rows);
+        fig.layout = opts.layout;
+        fig.panel_size = opts.panel_size;
+        for ext in ["png", "svg", "pdf"] {
             draw_figure(&fig, &opts.out_dir.join(format!("{stem}.{ext}"))).map_err(|e| e.to_string())?;
         }
         fig.log_y = true;
@@ -163,7 +152,7 @@ fn fmt_opt(v: Option<f64>) -> String {
 pub fn table_markdown(rows: &[TableRow], opts: &FiguresOptions) -> String {
     let mut s = String::from("# Fit errors\n\n");
     s += &format!(
-        "Written by `paperbsdf plot --figures --data-dir {} --out {}` (seconds: wall-clock time of each fit). Each data set is fitted on the incident angles {:?} (those it has); \
+        "Written by `paperbsdf plot --figures --data-dir {} --out {}` (the time of each fit is printed, not kept here, so that rerunning leaves this file unchanged). Each data set is fitted on the incident angles {:?} (those it has); \
          the remaining angles are extrapolation. Error: weighted RMS of ln((f_model + e)/(f_meas + e)), e = {}, \
          weights 1/max(stderr/(f_meas + e), {})^2 (crates/fit/src/objective.rs). The bundled sets are simulated \
          (data/README.md); `devA`, `devB` are the independent brute-force references (Mitsuba 3).\n\n",
@@ -173,8 +162,8 @@ pub fn table_markdown(rows: &[TableRow], opts: &FiguresOptions) -> String {
         paperbsdf_fit::objective::LOG_OFFSET,
         paperbsdf_fit::objective::SIGMA_FLOOR
     );
-    s += "| data | model | fitted RMS log error | extrapolation RMS log error | fitted / extrap. points | seconds | distributions |\n";
-    s += "|---|---|---|---|---|---|---|\n";
+    s += "| data | model | fitted RMS log error | extrapolation RMS log error | fitted / extrap. points | distributions |\n";
+    s += "|---|---|---|---|---|---|\n";
     let mut names: Vec<&str> = rows.iter().map(|r| r.data.as_str()).collect();
     names.dedup();
     let mut order: Vec<&str> = Vec::new();
@@ -187,14 +176,13 @@ pub fn table_markdown(rows: &[TableRow], opts: &FiguresOptions) -> String {
         for r in rows.iter().filter(|r| r.data == *n) {
             let o = &r.outcome;
             s += &format!(
-                "| {} | {} | {:.4} | {} | {} / {} | {:.2} | {} |\n",
+                "| {} | {} | {:.4} | {} | {} / {} | {} |\n",
                 r.data,
                 o.model,
                 o.rms_log_error,
                 fmt_opt(o.extrapolation_rms_log_error),
                 o.counts.0,
                 o.counts.1,
-                o.seconds,
                 o.variant
             );
         }

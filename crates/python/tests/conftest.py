@@ -14,7 +14,7 @@ sys.path.insert(0, TOOLS)
 import _common  # noqa: E402
 
 REPO = _common.REPO
-SHARED = os.path.join(os.path.dirname(REPO), "shared")
+SHARED = os.path.join(REPO, "data")  # holds reference/: the bundled reference data
 
 
 @pytest.fixture(scope="session")

@@ -559,8 +559,28 @@ fn params_file(rel: &str, res: &Resources) -> Result<PaperParams, String> {
             is_toml,
         }
     } else {
+        // A file relative to the scene file, else a preset name; a FIT.json is read
+        // for its `params` (and must be a fit of the `paper` model).
         let path = res.base_dir.join(rel);
-        paperbsdf_io::load_params::<PaperParams>(&path.to_string_lossy()).map_err(|e| e.to_string())?
+        let source = if path.exists() || paper_model::preset(rel).is_none() {
+            path.to_string_lossy().to_string()
+        } else {
+            rel.to_string()
+        };
+        let s = paperbsdf_io::read_source_full(&source).map_err(|e| e.to_string())?;
+        if let Some(model) = s.fit_model.as_deref().filter(|m| *m != "paper") {
+            return Err(format!(
+                "{}: a fit of the model `{model}`; a `paper` material needs a fit of the `paper` model",
+                s.origin
+            ));
+        }
+        paperbsdf_io::Loaded {
+            value: paperbsdf_io::params::parse_text::<PaperParams>(&s.text, &s.origin, s.is_toml)
+                .map_err(|e| e.to_string())?,
+            origin: s.origin,
+            text: s.text,
+            is_toml: s.is_toml,
+        }
     };
     loaded.value.validate().map_err(|e| loaded.param_error(e).to_string())?;
     Ok(loaded.value)

@@ -9,14 +9,15 @@
 
 use paperbsdf_core::Rgb;
 use paperbsdf_render::{builtin, film, RenderOptions};
-use std::path::Path;
 use std::sync::atomic::AtomicBool;
+
+mod common;
 
 const REF_SPP: f64 = 16384.0;
 
 fn reference() -> (usize, usize, Vec<Rgb>) {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/reference/scene_ref.exr");
-    film::read_exr(&p).expect("reference EXR")
+    let p = common::reference("scene_ref.exr");
+    film::read_exr(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
 
 #[test]

@@ -46,7 +46,7 @@ fn paper(name: &str, d: f64, sigma_a: f64, sigma_s: f64, m_f: f64, m_b: f64, dis
 
 fn cases() -> Vec<(String, PaperParams)> {
     let dev = |f: &str| -> PaperParams {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/reference/").to_string() + f;
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/reference/").to_string() + f;
         serde_json::from_str(&std::fs::read_to_string(&path).expect("reference parameters")).expect("valid JSON")
     };
     let mut v: Vec<(String, PaperParams)> = paperbsdf_core::presets::PRESET_NAMES
@@ -199,7 +199,7 @@ fn component_errors(points: &[&Point], nc: usize) -> [f64; 3] {
 
 const ORDER_NAMES: [&str; 3] = ["surface/unscattered", "single", "multiple"];
 
-fn plot(path: &str, title: &str, res: &[AngleResult]) -> Result<(), Box<dyn std::error::Error>> {
+fn plot(path: &str, title: &str, res: &[AngleResult], rgb: bool) -> Result<(), Box<dyn std::error::Error>> {
     let root = SVGBackend::new(path, (1200, 900)).into_drawing_area();
     root.fill(&WHITE)?;
     let root = root.titled(title, ("sans-serif", 22))?;
@@ -215,37 +215,63 @@ fn plot(path: &str, title: &str, res: &[AngleResult]) -> Result<(), Box<dyn std:
         }
         let lo = (lo * 0.7).max(1e-4);
         let hi = (hi * 1.5).max(lo * 10.0);
+        // Log10 coordinates with ticks at round values (paperbsdf-plot's helpers), so
+        // labels read 0.03, 0.05, 0.1, ... rather than float noise.
+        let (llo, lhi) = (lo.log10(), hi.log10());
+        let ticks = paperbsdf_plot::log_ticks(llo, lhi);
         let mut chart = ChartBuilder::on(panel)
-            .caption(format!("theta_i = {}", r.theta_i), ("sans-serif", 18))
+            .caption(format!("θi = {}°", r.theta_i), ("sans-serif", 18))
             .margin(8)
-            .x_label_area_size(30)
-            .y_label_area_size(55)
-            .build_cartesian_2d(-85f64..85f64, (lo..hi).log_scale())?;
+            .margin_right(16)
+            .x_label_area_size(40)
+            .y_label_area_size(80)
+            .build_cartesian_2d(
+                paperbsdf_plot::TickedAxis {
+                    lo: -85.0,
+                    hi: 85.0,
+                    ticks: vec![-80.0, -60.0, -40.0, -20.0, 0.0, 20.0, 40.0, 60.0, 80.0],
+                },
+                paperbsdf_plot::TickedAxis {
+                    lo: llo,
+                    hi: lhi,
+                    ticks,
+                },
+            )?;
         chart
             .configure_mesh()
-            .x_desc("theta_o (deg)")
-            .y_desc("f (1/sr), channel 0")
+            .x_desc("θo (degrees; negative: opposite the light)")
+            .y_desc(if rgb { "f (1/sr), red channel" } else { "f (1/sr)" })
+            .x_label_formatter(&|v| format!("{}", v.round() as i64))
+            .y_label_formatter(&|v| paperbsdf_plot::tick_label(10f64.powf(*v), 2))
             .draw()?;
+        let lo = llo;
         for (t, colour, label) in [(false, RGBColor(200, 60, 20), "R"), (true, RGBColor(20, 90, 200), "T")] {
             let pts: Vec<&Point> = r.points.iter().filter(|p| p.transmission == t).collect();
             chart
                 .draw_series(LineSeries::new(
-                    pts.iter().map(|p| (p.theta_o, p.model.0[0].max(lo))),
+                    pts.iter()
+                        .map(|p| (p.theta_o, p.model.0[0].max(1e-300).log10().max(lo))),
                     colour.stroke_width(2),
                 ))?
                 .label(format!("{label} model"))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
             chart
-                .draw_series(
-                    pts.iter()
-                        .map(|p| Circle::new((p.theta_o, p.sim.mean.0[0].max(lo)), 4, colour.filled())),
-                )?
+                .draw_series(pts.iter().map(|p| {
+                    Circle::new(
+                        (p.theta_o, p.sim.mean.0[0].max(1e-300).log10().max(lo)),
+                        4,
+                        colour.filled(),
+                    )
+                }))?
                 .label(format!("{label} simulation"))
                 .legend(move |(x, y)| Circle::new((x + 10, y), 4, colour.filled()));
             for p in &pts {
                 let (m, s) = (p.sim.mean.0[0], p.sim.stderr.0[0]);
                 chart.draw_series(std::iter::once(PathElement::new(
-                    vec![(p.theta_o, (m - 2.0 * s).max(lo)), (p.theta_o, (m + 2.0 * s).max(lo))],
+                    vec![
+                        (p.theta_o, (m - 2.0 * s).max(1e-300).log10().max(lo)),
+                        (p.theta_o, (m + 2.0 * s).max(1e-300).log10().max(lo)),
+                    ],
                     colour.stroke_width(1),
                 )))?;
             }
@@ -344,6 +370,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &format!("{out_dir}/{svg}"),
             &format!("{name}: Paper BSDF (lines) vs simulation (dots, 2 sigma bars)"),
             &res,
+            nc == 3,
         )?;
 
         writeln!(

@@ -6,7 +6,7 @@ use paperbsdf_sim::*;
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let n: u64 = args[1].parse().unwrap();
-    let text = std::fs::read_to_string("../shared/reference/devA.json").unwrap();
+    let text = std::fs::read_to_string("data/reference/devA.json").unwrap();
     let base: paperbsdf_core::PaperParams = serde_json::from_str(&text).unwrap();
     let cfg = SimConfig {
         samples: n,

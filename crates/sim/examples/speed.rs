@@ -17,7 +17,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let name = args.get(1).map(String::as_str).unwrap_or("devA");
     let n: u64 = args.get(2).map(|s| s.parse().unwrap()).unwrap_or(32768);
-    let text = std::fs::read_to_string(format!("../shared/reference/{name}.json")).unwrap();
+    let text = std::fs::read_to_string(format!("data/reference/{name}.json")).unwrap();
     let mut p: paperbsdf_core::PaperParams = serde_json::from_str(&text).unwrap();
     for a in args.iter().skip(3) {
         if let Ok(fs) = a.parse::<paperbsdf_core::FaceScattering>() {

@@ -1,5 +1,5 @@
 //! Total reflectance and transmittance against adding-doubling (iadpython 0.5.3,
-//! `../shared/reference/slab_rt_dev.csv`) and van de Hulst's tabulated case.
+//! `data/reference/slab_rt_dev.csv`) and van de Hulst's tabulated case.
 //!
 //! Slab: smooth Fresnel faces of index `n` in air (n = 1: no interface), one
 //! Henyey-Greenstein lobe `g`, albedo `a`, optical thickness `tau` (d = 1 mm,

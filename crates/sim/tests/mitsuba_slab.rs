@@ -1,4 +1,4 @@
-//! The simulator against Mitsuba 3's volumetric path tracer (`../shared/reference/devA.csv`,
+//! The simulator against Mitsuba 3's volumetric path tracer (`data/reference/devA.csv`,
 //! `devB.csv`: brute-force in-plane BSDF of the same physical slab, parameters in
 //! `devA.json`, `devB.json`; produced by `reference/tools/genref.py`).
 //!
@@ -22,7 +22,7 @@
 //!
 //! The `theta_i = 75` rows of devA.csv and devB.csv are replaced by the
 //! reciprocal remeasurement of `devA_grazing.csv`, `devB_grazing.csv` (camera at
-//! 75 degrees, light at `theta_o`; see `../shared/reference/README.md`): Mitsuba's
+//! 75 degrees, light at `theta_o`; see `data/reference/README.md`): Mitsuba's
 //! directional light at grazing incidence on a rough face is not reciprocal
 //! (measured with `reference/tools/slabref.py`: R(75 -> 0) = 0.1311 +- 0.0010 but
 //! R(0 -> 75) = 0.1076 +- 0.0013 for devA, and the slab is reciprocal). The four

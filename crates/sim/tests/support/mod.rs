@@ -1,6 +1,6 @@
 //! Shared helpers of the simulator's tests: reading the independent reference files in
-//! `../shared/reference` beside the repository (as in CI; `$PAPERBSDF_SHARED/reference`
-//! overrides), produced by Mitsuba 3 and iadpython.
+//! the repository's `data/reference` (`$PAPERBSDF_REFERENCE` overrides), produced by
+//! Mitsuba 3 and iadpython.
 //!
 //! Known defect of that data: the `theta_i = 75` rows of devA.csv and devB.csv are not
 //! reciprocal (Mitsuba's directional light at grazing incidence on a rough face; see
@@ -16,19 +16,25 @@
 use paperbsdf_core::PaperParams;
 use std::path::PathBuf;
 
-/// Path of a file of the shared reference data.
+/// Path of a file of the reference data (`data/reference` in the repository).
 pub fn data(name: &str) -> PathBuf {
-    std::env::var_os("PAPERBSDF_SHARED")
+    std::env::var_os("PAPERBSDF_REFERENCE")
         .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"))
-        .join("reference")
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../data/reference"))
         .join(name)
+}
+
+/// The text of a reference file; a missing file panics with its full path.
+pub fn read_text(name: &str) -> String {
+    let path = data(name);
+    std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("reference data {}: {e} (see data/reference/README.md)", path.display()))
 }
 
 /// Parameters from a JSON file of the reference data, with Walter's single-scattering
 /// faces (`face_scattering = "single"`, as the references were made).
 pub fn params(name: &str) -> PaperParams {
-    let text = std::fs::read_to_string(data(name)).unwrap();
+    let text = read_text(name);
     let mut p: PaperParams = serde_json::from_str(&text).unwrap();
     p.face_scattering = paperbsdf_core::FaceScattering::Single;
     p
@@ -51,7 +57,7 @@ pub struct RefRow {
 
 /// Reads a Mitsuba in-plane reference CSV (`kind,theta_i_deg,theta_o_deg,f,stderr,samples`).
 pub fn read_inplane(name: &str) -> Vec<RefRow> {
-    let text = std::fs::read_to_string(data(name)).unwrap();
+    let text = read_text(name);
     text.lines()
         .filter(|l| l.starts_with('R') || l.starts_with('T'))
         .map(|l| {
@@ -112,7 +118,7 @@ pub struct AdRow {
 
 /// Reads slab_rt_dev.csv.
 pub fn read_ad() -> Vec<AdRow> {
-    let text = std::fs::read_to_string(data("slab_rt_dev.csv")).unwrap();
+    let text = read_text("slab_rt_dev.csv");
     text.lines()
         .filter(|l| l.starts_with(|c: char| c.is_ascii_digit()))
         .map(|l| {
