@@ -122,7 +122,7 @@ fn bad_inputs_are_clear_errors() {
         // out of range, TOML: names file, line, parameter, range
         (
             vec!["--params".into(), p("a.toml", "eta = 1.5\nm = 2.0\ndist = \"ggx\"\n")],
-            vec!["a.toml:2", "`m`", "2", "1.57"],
+            vec!["a.toml:2", "`m`", "2", "pi/2"],
         ),
         // missing field
         (

@@ -171,9 +171,27 @@ fn albedo(
 }
 
 /// Checks that neither integral exceeds `1 + 1e-3` (plus 4 standard errors of
-/// the estimate) at one random direction on each side; returns the violations.
-fn check_energy(name: &str, b: &dyn Bsdf, rng: &mut Pcg64, radiance_eta: Option<f64>, what: &str) -> Vec<String> {
+/// the estimate) at one random direction on each side; returns the violations
+/// and the number of screening alarms that the precise estimate cleared.
+///
+/// Two stages. The screening estimate (10 batches of 10 x 10 samples) is
+/// cheap but its standard error, from only 10 batch means of a heavy-tailed
+/// weight (delta lobes and strategies picked a few times per batch), is
+/// itself uncertain: now and then it comes out far too small and a set with
+/// an albedo of 0.999 reads 1.04 "+- 1e-3". Every alarm is therefore measured
+/// again independently with 8 batches of 200 x 200 samples (batch means of
+/// 40000 samples are close to normal, so their standard error is reliable),
+/// and only what that estimate confirms is a violation. The tolerance is not
+/// widened: the confirmed estimate must itself stay below `1 + 1e-3 + 4 sigma`.
+fn check_energy(
+    name: &str,
+    b: &dyn Bsdf,
+    rng: &mut Pcg64,
+    radiance_eta: Option<f64>,
+    what: &str,
+) -> (Vec<String>, usize) {
     let mut bad = Vec::new();
+    let mut cleared = 0;
     for side in [1.0, -1.0] {
         let theta = if rng.gen::<bool>() {
             rng.gen::<f64>() * 89.5
@@ -184,18 +202,31 @@ fn check_energy(name: &str, b: &dyn Bsdf, rng: &mut Pcg64, radiance_eta: Option<
         for over in [Over::Wo, Over::Wi] {
             let (r, t, se) = albedo(b, w, over, 10, 10, rng.gen(), radiance_eta);
             let a = r + t;
+            let seed2: u64 = rng.gen();
             for c in 0..3 {
                 assert!(a.0[c].is_finite() && a.0[c] >= 0.0, "{name} {what} {w:?}: {a:?}");
+            }
+            if (0..3).all(|c| a.0[c] <= 1.0 + 1e-3 + 4.0 * se.0[c]) {
+                continue;
+            }
+            let (r, t, se) = albedo(b, w, over, 200, 8, seed2, radiance_eta);
+            let a = r + t;
+            let mut confirmed = false;
+            for c in 0..3 {
                 if a.0[c] > 1.0 + 1e-3 + 4.0 * se.0[c] {
+                    confirmed = true;
                     bad.push(format!(
                         "{name} over {over:?} at {w:?}: albedo {:.5} +- {:.1e} (channel {c}) {what}",
                         a.0[c], se.0[c]
                     ));
                 }
             }
+            if !confirmed {
+                cleared += 1;
+            }
         }
     }
-    bad
+    (bad, cleared)
 }
 
 /// No albedo above 1 for 2000 random parameter sets of the Paper BSDF and
@@ -203,14 +234,18 @@ fn check_energy(name: &str, b: &dyn Bsdf, rng: &mut Pcg64, radiance_eta: Option<
 /// rough dielectric, by both integrals, light from both faces.
 #[test]
 fn no_albedo_above_one_by_either_integral() {
-    let bad: Vec<String> = (0..2000u64)
+    let (bad, cleared): (Vec<String>, usize) = (0..2000u64)
         .into_par_iter()
-        .flat_map_iter(|set| {
+        .map(|set| {
             let mut rng = Pcg64::seed_from_u64(1000 + set);
             let p = random_params(&mut rng);
             let what = format!("{p:?}");
-            let mut bad = check_energy("paper", &PaperBsdf::new(&p).unwrap(), &mut rng, None, &what);
-            bad.extend(check_energy(
+            let mut out = check_energy("paper", &PaperBsdf::new(&p).unwrap(), &mut rng, None, &what);
+            let mut add = |(b, c): (Vec<String>, usize)| {
+                out.0.extend(b);
+                out.1 += c;
+            };
+            add(check_energy(
                 "reduced-multilayer",
                 &PaperBsdf::reduced_multilayer(&p).unwrap(),
                 &mut rng,
@@ -228,7 +263,7 @@ fn no_albedo_above_one_by_either_integral() {
                     dist: p.dist_f,
                 };
                 let what = format!("{lg:?}");
-                bad.extend(check_energy(
+                add(check_energy(
                     "lambert-glass",
                     &LambertGlass::new(&lg).unwrap(),
                     &mut rng,
@@ -243,55 +278,20 @@ fn no_albedo_above_one_by_either_integral() {
                 };
                 let what = format!("{rd:?}");
                 let b = rd.build().unwrap();
-                bad.extend(check_energy("rough-dielectric", &b, &mut rng, Some(rd.eta), &what));
+                add(check_energy("rough-dielectric", &b, &mut rng, Some(rd.eta), &what));
             }
-            bad
+            out
         })
-        .collect();
-    eprintln!("{} violations of 16000 checks:\n{}", bad.len(), bad.join("\n"));
-    // KNOWN OPEN DEFECT (issue 14 stays open for it): a handful of sheets whose
-    // front coating has a large index contrast with the base (the collimated
-    // adding of `paper::face`, step 3) reflect and transmit up to 4% more than
-    // arrives; 7 of the 16000 checks here, all with eta_f != eta_b. Until the
-    // coating is combined over directions, the test bounds how rare and how
-    // large the excess is instead of asserting there is none; every sheet
-    // without a coating must pass exactly.
-    let uncoated_bad: Vec<&String> = bad
-        .iter()
-        .filter(|b| coating_ratio(b).is_none_or(|r| r == 1.0))
-        .collect();
-    assert!(
-        uncoated_bad.is_empty(),
-        "sheets without a coating exceed 1:\n{uncoated_bad:?}"
-    );
-    assert!(
-        bad.len() <= 16,
-        "{} violations (more than the 16 the coating defect allows)",
+        .reduce(|| (Vec::new(), 0), |mut a, b| {
+            a.0.extend(b.0);
+            (a.0, a.1 + b.1)
+        });
+    eprintln!(
+        "16000 checks: {} screening alarms cleared by the precise estimate, {} confirmed violations",
+        cleared,
         bad.len()
     );
-    for b in &bad {
-        let a: f64 = b
-            .split("albedo ")
-            .nth(1)
-            .and_then(|t| t.split(' ').next())
-            .and_then(|t| t.parse().ok())
-            .unwrap_or(9.0);
-        assert!(a < 1.05, "excess above 5%: {b}");
-    }
-}
-
-/// `eta_f / eta_b` of the `PaperParams` printed in a violation line (`None` for other models).
-fn coating_ratio(line: &str) -> Option<f64> {
-    let num = |key: &str| -> Option<f64> {
-        line.split(&format!("{key}: "))
-            .nth(1)?
-            .split(',')
-            .next()?
-            .trim()
-            .parse()
-            .ok()
-    };
-    Some(num("eta_f")? / num("eta_b")?)
+    assert!(bad.is_empty(), "{} albedos above 1:\n{}", bad.len(), bad.join("\n"));
 }
 
 /// The white furnace: a sheet that absorbs nothing, with energy-conserving

@@ -55,7 +55,7 @@ pub(crate) fn to_face_frame(w: DVec3, side: usize) -> DVec3 {
     }
 }
 
-/// For `wi`, `wo` both above a face: `(h.z^2, wo.h)` of their unit half
+/// For `wi`, `wo` both above a face: `(h.z^2, (wo.h)^2)` of their unit half
 /// vector `h = (wi + wo) / |wi + wo|`, without forming it: `|wi + wo|^2 =
 /// 2 (1 + wi.wo)`, so `h.z^2 = (wi.z + wo.z)^2 / (2 (1 + wi.wo))` and
 /// `wo.h = wi.h = sqrt((1 + wi.wo) / 2)` (both see the front of `h`). `None`
@@ -70,7 +70,7 @@ fn reflection_half(wi: DVec3, wo: DVec3) -> Option<(f64, f64)> {
         return None;
     }
     let zs = wi.z + wo.z;
-    Some((zs * zs / (2.0 * k), (0.5 * k).sqrt().min(1.0)))
+    Some((zs * zs / (2.0 * k), 0.5 * k))
 }
 
 /// Nodes of the per-face tables in the outside cosine (`mu = t^2`, `t` uniform).
@@ -554,16 +554,19 @@ impl Face {
         self.r_out(mu)
     }
 
-    /// [`fresnel_dielectric`] for light from outside at cosine `c` in `(0, 1]`
-    /// on the rough interface (`eta >= 1`: no total internal reflection), with
-    /// its `1 / eta^2` in place of a division.
+    /// [`fresnel_dielectric`] for light from outside on the rough interface
+    /// (`eta >= 1`: no total internal reflection) at the cosine `c = sqrt(c2)`,
+    /// given `c2` in `(0, 1]`, with the interface's `1 / eta^2` in place of a
+    /// division. From `c2`, the square roots of `c` and of the refracted
+    /// cosine are independent and run side by side rather than one after the other.
     #[inline]
-    pub fn fresnel_outside(&self, c: f64) -> f64 {
+    pub fn fresnel_outside_sq(&self, c2: f64) -> f64 {
         if self.bd.eta == 1.0 {
             return 0.0;
         }
-        let cos_t = (1.0 - (1.0 - c * c) * self.inv_eta2).max(0.0).sqrt();
-        crate::fresnel::fresnel_from_cosines(c, cos_t, self.bd.eta)
+        let c2 = c2.min(1.0);
+        let cos_t = (1.0 - (1.0 - c2) * self.inv_eta2).max(0.0).sqrt();
+        crate::fresnel::fresnel_from_cosines(c2.sqrt(), cos_t, self.bd.eta)
     }
 
     /// `1 / n` of the base.
@@ -624,18 +627,26 @@ impl Face {
     /// separable lobes; zero for a face without microfacets (its reflection is a delta).
     #[inline]
     pub fn reflection(&self, wi: DVec3, wo: DVec3) -> f64 {
+        self.reflection_with_sqrt(wi, wo, wi.z.min(1.0).sqrt(), wo.z.min(1.0).sqrt())
+    }
+
+    /// [`Face::reflection`] given also `si = sqrt(min(wi.z, 1))` and
+    /// `so = sqrt(min(wo.z, 1))` (the separable lobes' table coordinates),
+    /// which the callers already have.
+    #[inline]
+    pub fn reflection_with_sqrt(&self, wi: DVec3, wo: DVec3, si: f64, so: f64) -> f64 {
         let Interface::Rough(mf) = self.bd.interface else {
             return 0.0;
         };
-        let Some((c2, oh)) = reflection_half(wi, wo) else {
+        let Some((c2, oh2)) = reflection_half(wi, wo) else {
             return 0.0;
         };
         let lobes = if self.lobes.is_empty() {
             0.0
         } else {
-            self.lobes_reflection(wi.z.min(1.0).sqrt(), wo.z.min(1.0).sqrt())
+            self.lobes_reflection(si, so)
         };
-        self.fresnel_outside(oh) * mf.reflection_dg_c2(c2, wi.z, wo.z) + lobes
+        self.fresnel_outside_sq(oh2) * mf.reflection_dg_c2(c2, wi.z, wo.z) + lobes
     }
 
     /// Density of [`Face::sample_reflection`]: `pdf_visible(wo, h) / (4 |wo.h|)`.
@@ -649,22 +660,23 @@ impl Face {
     }
 
     /// `(f_r, pdf)`: [`Face::reflection`] and [`Face::reflection_pdf`] at once,
-    /// sharing `D(h)` and the masking of `wo` (for `sample`, which needs both).
+    /// sharing `D(h)` and the masking of `wo` (for `sample`, which needs both);
+    /// `si`, `so` as in [`Face::reflection_with_sqrt`].
     #[inline]
-    pub fn reflection_and_pdf(&self, wi: DVec3, wo: DVec3) -> (f64, f64) {
+    pub fn reflection_and_pdf(&self, wi: DVec3, wo: DVec3, si: f64, so: f64) -> (f64, f64) {
         let Interface::Rough(mf) = self.bd.interface else {
             return (0.0, 0.0);
         };
-        let Some((c2, oh)) = reflection_half(wi, wo) else {
+        let Some((c2, oh2)) = reflection_half(wi, wo) else {
             return (0.0, 0.0);
         };
         let (dg, pdf) = mf.reflection_dg_pdf_c2(c2, wi.z, wo.z);
         let lobes = if self.lobes.is_empty() {
             0.0
         } else {
-            self.lobes_reflection(wi.z.min(1.0).sqrt(), wo.z.min(1.0).sqrt())
+            self.lobes_reflection(si, so)
         };
-        (self.fresnel_outside(oh) * dg + lobes, pdf)
+        (self.fresnel_outside_sq(oh2) * dg + lobes, pdf)
     }
 
     /// Walter's reflectance from outside alone (the visible-normal strategy's estimate).

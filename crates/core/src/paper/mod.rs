@@ -907,17 +907,17 @@ impl PaperBsdf {
         }
         let (e, x) = (side(wi), side(wo));
         let reflect = e == x;
+        let (mi_out, mo_out) = (wi.z.abs(), wo.z.abs());
+        let (si, so) = (mi_out.min(1.0).sqrt(), mo_out.min(1.0).sqrt());
         let mut out = Rgb::ZERO;
         if reflect && set.contains(Component::Surface) {
             let f = match surface {
                 Some(f) => f,
-                None => self.faces[e].reflection(to_face_frame(wi, e), to_face_frame(wo, e)),
+                None => self.faces[e].reflection_with_sqrt(to_face_frame(wi, e), to_face_frame(wo, e), si, so),
             };
             out += Rgb::splat(f);
         }
         let (fe, fx) = (&self.faces[e], &self.faces[x]);
-        let (mi_out, mo_out) = (wi.z.abs(), wo.z.abs());
-        let (si, so) = (mi_out.min(1.0).sqrt(), mo_out.min(1.0).sqrt());
         let mut sub = Rgb::ZERO;
         if set.contains(Component::Multiple) {
             if self.opts.energy_bound {
@@ -1227,7 +1227,8 @@ impl Bsdf for PaperBsdf {
         let geo = self.inside(wi, wo, true);
         // Reflection on a rough face: its value and density share the half vector.
         let (surf_f, surf_pdf) = if wi.z * wo.z > 0.0 && self.faces[x].microfacet().is_some() {
-            let (f, p) = self.faces[x].reflection_and_pdf(to_face_frame(wi, x), to_face_frame(wo, x));
+            let (si, so) = (wi.z.abs().min(1.0).sqrt(), wo.z.abs().min(1.0).sqrt());
+            let (f, p) = self.faces[x].reflection_and_pdf(to_face_frame(wi, x), to_face_frame(wo, x), si, so);
             (Some(f), Some(p))
         } else {
             (None, None)
