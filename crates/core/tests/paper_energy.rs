@@ -282,10 +282,13 @@ fn no_albedo_above_one_by_either_integral() {
             }
             out
         })
-        .reduce(|| (Vec::new(), 0), |mut a, b| {
-            a.0.extend(b.0);
-            (a.0, a.1 + b.1)
-        });
+        .reduce(
+            || (Vec::new(), 0),
+            |mut a, b| {
+                a.0.extend(b.0);
+                (a.0, a.1 + b.1)
+            },
+        );
     eprintln!(
         "16000 checks: {} screening alarms cleared by the precise estimate, {} confirmed violations",
         cleared,
