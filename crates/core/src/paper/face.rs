@@ -297,6 +297,9 @@ pub(crate) struct Face {
     r_lobes_tab: [f64; NA],
     /// Separable reflection lobes: the compensation and the coating's (at most two).
     lobes: Vec<SeparableLobe>,
+    /// `sqrt(c_j) E_j` of the lobes on the [`NA`] nodes, side by side (zero
+    /// for an absent lobe): what `eval` interpolates, one node lookup for both.
+    lobe_tab: [[f64; 2]; NA],
     /// `rho_in` and `Tbar_in` for diffuse light from inside the base.
     rho_in: f64,
     tbar_in: f64,
@@ -352,6 +355,7 @@ impl Face {
             r_tab: [0.0; NA],
             r_lobes_tab: [0.0; NA],
             lobes: Vec::new(),
+            lobe_tab: [[0.0; 2]; NA],
             rho_in: 0.0,
             tbar_in: 0.0,
             iface_k: ifc.k,
@@ -402,6 +406,9 @@ impl Face {
         }
         for k in 0..NA {
             f.r_lobes_tab[k] = f.lobes.iter().map(|l| l.albedo_scale * l.e[k]).sum();
+            for (j, l) in f.lobes.iter().enumerate() {
+                f.lobe_tab[k][j] = l.c.sqrt() * l.e[k];
+            }
         }
         // Diffuse light from inside the base.
         let (rho, tbar) = match coating {
@@ -616,10 +623,15 @@ impl Face {
     /// The separable lobes' reflection `sum_j c_j E_j(mu_i) E_j(mu_o)`, given `st = sqrt(mu)` of both.
     #[inline]
     pub fn lobes_reflection(&self, si: f64, so: f64) -> f64 {
-        self.lobes
-            .iter()
-            .map(|l| l.c * lerp_sqrt(&l.e, si) * lerp_sqrt(&l.e, so))
-            .sum()
+        let node = |st: f64| {
+            let x = st * (NA - 1) as f64;
+            let i = (x as usize).min(NA - 2);
+            let f = x - i as f64;
+            let (a, b) = (self.lobe_tab[i], self.lobe_tab[i + 1]);
+            [a[0] * (1.0 - f) + b[0] * f, a[1] * (1.0 - f) + b[1] * f]
+        };
+        let (a, b) = (node(si), node(so));
+        a[0] * b[0] + a[1] * b[1]
     }
 
     /// Reflection `f_r(wi, wo)` (no cosine) of the face, both directions in
@@ -694,7 +706,9 @@ impl Face {
         if oh <= 0.0 {
             return None;
         }
+        // The mirror image of the unit `wo` about the unit `h` is a unit vector
+        // (to rounding): no normalisation needed.
         let wi = 2.0 * oh * h - wo;
-        (wi.z > 0.0).then(|| wi.normalize())
+        (wi.z > 0.0).then_some(wi)
     }
 }

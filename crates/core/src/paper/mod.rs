@@ -275,6 +275,9 @@ fn side(w: DVec3) -> usize {
 struct Inside {
     mu_i: f64,
     mu_o: f64,
+    /// `sqrt(min(|wi.z|, 1))`, `sqrt(min(|wo.z|, 1))` outside: the coordinates of the face tables.
+    si: f64,
+    so: f64,
     /// The phase function as `p_num / p_den` (`p_num = 0`, `p_den = 1` if not asked).
     p_num: f64,
     p_den: f64,
@@ -874,7 +877,7 @@ impl PaperBsdf {
     /// Inside cosines of `wi`, `wo` and (if `want_phase`) the phase function
     /// between the inside directions: what `eval` and `pdf` share.
     #[inline(always)]
-    fn inside(&self, wi: DVec3, wo: DVec3, want_phase: bool) -> Inside {
+    fn inside(&self, wi: DVec3, wo: DVec3, want_phase: bool, (si, so): (f64, f64)) -> Inside {
         let (t_i, t_o, mu_i, mu_o) = self.inside_dirs(wi, wo);
         let (p_num, p_den) = if want_phase && self.lobe_sum > 0.0 {
             self.phase_ratio(t_i.dot(t_o).clamp(-1.0, 1.0))
@@ -884,6 +887,8 @@ impl PaperBsdf {
         Inside {
             mu_i,
             mu_o,
+            si,
+            so,
             p_num,
             p_den,
         }
@@ -907,8 +912,10 @@ impl PaperBsdf {
         }
         let (e, x) = (side(wi), side(wo));
         let reflect = e == x;
-        let (mi_out, mo_out) = (wi.z.abs(), wo.z.abs());
-        let (si, so) = (mi_out.min(1.0).sqrt(), mo_out.min(1.0).sqrt());
+        let (si, so) = match pre {
+            Some(g) => (g.si, g.so),
+            None => (wi.z.abs().min(1.0).sqrt(), wo.z.abs().min(1.0).sqrt()),
+        };
         let mut out = Rgb::ZERO;
         if reflect && set.contains(Component::Surface) {
             let f = match surface {
@@ -935,7 +942,7 @@ impl PaperBsdf {
         }
         let g = match pre {
             Some(g) => *g,
-            None => self.inside(wi, wo, set.contains(Component::Single)),
+            None => self.inside(wi, wo, set.contains(Component::Single), (si, so)),
         };
         let (mu_i, mu_o) = (g.mu_i, g.mu_o);
         if mu_i <= 0.0 || mu_o <= 0.0 {
@@ -1131,7 +1138,8 @@ impl PaperBsdf {
         if pr[1] > 0.0 {
             let g = match pre {
                 Some(g) => *g,
-                None => self.inside(wi, wo, true),
+                // The table coordinates are not needed for densities.
+                None => self.inside(wi, wo, true, (0.0, 0.0)),
             };
             pdf += pr[1] * self.pdf_single(wi, &g);
         }
@@ -1178,7 +1186,8 @@ impl Bsdf for PaperBsdf {
             1 => {
                 let fx = &self.faces[x];
                 let mu_o = fx.inside_cos(wo.z.abs());
-                let t_o = DVec3::new(wo.x * fx.inv_n(), wo.y * fx.inv_n(), sx * mu_o).normalize();
+                // A unit vector: |t_o|^2 = (1 - wo.z^2) / n^2 + mu_o^2 = 1 (Snell).
+                let t_o = DVec3::new(wo.x * fx.inv_n(), wo.y * fx.inv_n(), sx * mu_o);
                 // Reuse the lobe-choice number to pick the HG lobe.
                 let ucr = ((uc - acc) / pr[k]).clamp(0.0, 1.0 - 1e-16);
                 let g = if ucr * self.lobe_sum < self.lobes[0].1 {
@@ -1224,11 +1233,10 @@ impl Bsdf for PaperBsdf {
         if grazing(wi) || !wi.is_finite() {
             return None;
         }
-        let geo = self.inside(wi, wo, true);
+        let geo = self.inside(wi, wo, true, (wi.z.abs().min(1.0).sqrt(), wo.z.abs().min(1.0).sqrt()));
         // Reflection on a rough face: its value and density share the half vector.
         let (surf_f, surf_pdf) = if wi.z * wo.z > 0.0 && self.faces[x].microfacet().is_some() {
-            let (si, so) = (wi.z.abs().min(1.0).sqrt(), wo.z.abs().min(1.0).sqrt());
-            let (f, p) = self.faces[x].reflection_and_pdf(to_face_frame(wi, x), to_face_frame(wo, x), si, so);
+            let (f, p) = self.faces[x].reflection_and_pdf(to_face_frame(wi, x), to_face_frame(wo, x), geo.si, geo.so);
             (Some(f), Some(p))
         } else {
             (None, None)
