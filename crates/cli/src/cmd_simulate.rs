@@ -43,6 +43,11 @@ pub struct SimulateArgs {
     /// and the time it means are printed); raise it to run anyway.
     #[arg(long = "max-collisions", default_value_t = DEFAULT_MAX_COLLISIONS)]
     pub max_collisions: f64,
+    /// Cut each random walk after this many scattering events, 1 or more
+    /// (the default cuts nothing in paper). Cut walks are counted, and a
+    /// warning says how much of the incident flux they took with them.
+    #[arg(long = "max-walk-collisions", default_value_t = paperbsdf_sim::walk::MAX_COLLISIONS_PER_WALK as u64)]
+    pub max_walk_collisions: u64,
     /// Seed; the output is reproducible for a given seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -107,6 +112,12 @@ fn config(a: &SimulateArgs) -> Result<SimConfig> {
     if a.max_collisions.is_nan() || a.max_collisions <= 0.0 {
         bail!("--max-collisions = {} must be positive", a.max_collisions);
     }
+    if a.max_walk_collisions == 0 {
+        bail!(
+            "--max-walk-collisions = 0 is outside the allowed range [1, {}] (scattering events per walk)",
+            u64::MAX
+        );
+    }
     let samples = match (a.samples, a.rel_stderr) {
         (Some(n), _) => n,
         (None, Some(_)) => ADAPTIVE_FIRST_ROUND,
@@ -120,6 +131,7 @@ fn config(a: &SimulateArgs) -> Result<SimConfig> {
         max_samples: a.max_samples,
         progress: true,
         by_order: false,
+        max_collisions_per_walk: a.max_walk_collisions,
     })
 }
 
@@ -207,9 +219,9 @@ the worst relative standard error is {worst:.3e}"
     }
     if truncated > 0 {
         let m = format!(
-            "WARNING {what}: {truncated} walks were cut at {} collisions; their remaining flux \
-(at most {:.3e} of the incident flux) is missing from these estimates",
-            paperbsdf_sim::walk::MAX_COLLISIONS_PER_WALK,
+            "WARNING {what}: {truncated} walks were cut at {} collisions (--max-walk-collisions); \
+their remaining flux (at most {:.3e} of the incident flux) is missing from these estimates",
+            cfg.max_collisions_per_walk,
             truncated as f64 / samples.max(1) as f64
         );
         eprintln!("warning: {}", m.trim_start_matches("WARNING "));
@@ -240,8 +252,13 @@ fn header_line(p: &PaperParams, cfg: &SimConfig) -> String {
         ),
         None => format!("{} walks per incident angle and channel", cfg.samples),
     };
+    let cap = if cfg.max_collisions_per_walk == paperbsdf_sim::walk::MAX_COLLISIONS_PER_WALK as u64 {
+        String::new()
+    } else {
+        format!(", walks cut at {} collisions", cfg.max_collisions_per_walk)
+    };
     format!(
-        "# paperbsdf simulate (Monte Carlo ground truth, paperbsdf-sim {}): f without cosine, theta_o < 0 opposite the light; {mode}, {} batches, seed {}; params: {json}\n",
+        "# paperbsdf simulate (Monte Carlo ground truth, paperbsdf-sim {}): f without cosine, theta_o < 0 opposite the light; {mode}{cap}, {} batches, seed {}; params: {json}\n",
         env!("CARGO_PKG_VERSION"),
         cfg.batches,
         cfg.seed
@@ -401,6 +418,7 @@ mod tests {
             batches: 8,
             seed: 3,
             max_collisions: DEFAULT_MAX_COLLISIONS,
+            max_walk_collisions: paperbsdf_sim::walk::MAX_COLLISIONS_PER_WALK as u64,
             out: None,
         }
     }

@@ -242,6 +242,106 @@ fn simulate_with_huge_sigma_s_is_bounded() {
     assert!(e.contains("collisions/s"), "{e}");
 }
 
+/// The per-walk collision cap (default 1e7, `--max-walk-collisions`) is
+/// reached and said: a conservative slab 1e4 mean free paths thick between
+/// index-matched faces, where every walk carries unit flux until it leaves or
+/// is cut. The warning (standard error) and the note (in the table) give the
+/// cut walks and the flux they took, which is exactly what `R + T` lacks; the
+/// header records the cap. A cap of 0 is a range error.
+#[test]
+fn simulate_reports_walks_cut_at_the_collision_cap() {
+    let p = r#"{"d":1,"sigma_a":0,"sigma_s":1e4,"g_f":0,"g_b":0,"w_b":0,"eta_f":1,"eta_b":1,"m_f":0,"m_b":0,"dist_f":"ggx","dist_b":"ggx"}"#;
+    let base = ["simulate", "--params", p, "--samples", "2048", "--batches", "8"];
+    let t = Instant::now();
+    let o = run(&[
+        &base[..],
+        &["--totals", "--theta-i", "30", "--max-walk-collisions", "1000"],
+    ]
+    .concat());
+    let (out, err) = (text(&o.stdout), text(&o.stderr));
+    assert!(o.status.success(), "{err}");
+    assert!(t.elapsed() < Duration::from_secs(60), "took {:?}", t.elapsed());
+    assert!(
+        out.starts_with("# paperbsdf simulate") && out.lines().next().unwrap().contains("walks cut at 1000 collisions"),
+        "{out}"
+    );
+    let warning = err
+        .lines()
+        .find(|l| l.starts_with("warning: theta_i 30: ") && l.contains("walks were cut at 1000 collisions"))
+        .unwrap_or_else(|| panic!("no warning of cut walks: {err}"));
+    let note = out
+        .lines()
+        .find(|l| l.starts_with("# WARNING theta_i 30: ") && l.contains("walks were cut at 1000 collisions"))
+        .unwrap_or_else(|| panic!("no note of cut walks: {out}"));
+    let cut: u64 = note
+        .split(": ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let frac: f64 = note
+        .split("at most ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(warning.contains(&format!("{cut} walks")), "{warning}");
+    assert!(cut > 0 && (frac - cut as f64 / 2048.0).abs() < 1e-3 * frac, "{note}");
+    let row: Vec<f64> = out
+        .lines()
+        .find(|l| l.starts_with("30,"))
+        .unwrap()
+        .split(',')
+        .map(|x| x.parse().unwrap())
+        .collect();
+    // Unit flux per walk, nothing absorbed: R + T = 1 - cut / samples (to the printed digits).
+    assert!((row[1] + row[3] - (1.0 - cut as f64 / 2048.0)).abs() < 1e-5, "{out}");
+    // BSDF values: the same warning.
+    let o = run(&[
+        &base[..],
+        &["--theta-i", "30", "--theta-o", "0", "--max-walk-collisions", "1000"],
+    ]
+    .concat());
+    let err = text(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("walks were cut at 1000 collisions (--max-walk-collisions)"),
+        "{err}"
+    );
+    // Without the option nothing is said about a cut of a thin slab.
+    let o = run(&[
+        "simulate",
+        "--params",
+        P,
+        "--totals",
+        "--theta-i",
+        "30",
+        "--samples",
+        "256",
+        "--batches",
+        "8",
+    ]);
+    assert!(
+        o.status.success() && !text(&o.stderr).contains("cut"),
+        "{}",
+        text(&o.stderr)
+    );
+    fails_with(
+        &[
+            &base[..],
+            &["--totals", "--theta-i", "30", "--max-walk-collisions", "0"],
+        ]
+        .concat(),
+        &["--max-walk-collisions = 0", "allowed range [1, "],
+    );
+}
+
 #[test]
 fn angles_print_cleanly_and_single_angles_work() {
     // `--theta-o 0:1:0.1` printed 0.30000000000000004.

@@ -189,7 +189,7 @@ fn huge_declared_shape_is_refused() {
 }
 
 /// Every single-byte corruption of the header, and random bytes, give an error or a
-/// usable file, never a panic (a deterministic sweep; the property-based fuzzing is issue 16's).
+/// usable file, never a panic (a deterministic sweep; the property-based fuzzing is in `fuzz_rgl.rs`).
 #[test]
 fn corrupted_headers_never_panic() {
     let full = satin_bytes();

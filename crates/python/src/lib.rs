@@ -439,6 +439,7 @@ fn simulate<'py>(
         max_samples,
         progress: false,
         by_order: false,
+        max_collisions_per_walk: paperbsdf_sim::walk::MAX_COLLISIONS_PER_WALK as u64,
     };
     let run = py
         .detach(|| paperbsdf_sim::simulate_bsdf(&slab, wi[0], &wo, &cfg))

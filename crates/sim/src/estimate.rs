@@ -10,8 +10,8 @@
 //! (all batches have the same number of walks).
 //!
 //! Limits: at most [`MAX_BATCHES`] batches; each walk is cut after
-//! [`MAX_COLLISIONS_PER_WALK`] collisions, and the runs report how many walks
-//! were cut ([`BsdfRun::truncated`]) so that a cut never biases a result
+//! [`SimConfig::max_collisions_per_walk`] collisions ([`MAX_COLLISIONS_PER_WALK`]
+//! by default), and the runs report how many walks were cut ([`BsdfRun::truncated`]) so that a cut never biases a result
 //! silently. [`estimate_work`] predicts the collisions a run will take (for a
 //! refusal before absurd runs), and the achieved precision is reported
 //! ([`BsdfRun::worst_rel_stderr`], [`BsdfRun::target_reached`]). When standard
@@ -67,6 +67,12 @@ pub struct SimConfig {
     pub progress: bool,
     /// Also estimate `f` split by scattering order ([`BsdfRun::by_order`]).
     pub by_order: bool,
+    /// Scattering events after which a walk is cut, at least 1 (default
+    /// [`MAX_COLLISIONS_PER_WALK`], which cuts nothing in paper). The cut walks
+    /// are counted ([`BsdfRun::truncated`]); their remaining flux is missing
+    /// from every estimate. A bound on the work of absurd slabs, and a way for
+    /// tests to reach the cut.
+    pub max_collisions_per_walk: u64,
 }
 
 impl Default for SimConfig {
@@ -79,6 +85,7 @@ impl Default for SimConfig {
             max_samples: 1 << 26,
             progress: false,
             by_order: false,
+            max_collisions_per_walk: MAX_COLLISIONS_PER_WALK as u64,
         }
     }
 }
@@ -136,9 +143,11 @@ pub struct BsdfRun {
     pub by_order: Option<Vec<[Estimate; 3]>>,
     /// Walks run per colour channel.
     pub samples: u64,
-    /// Walks (over all channels) cut at [`MAX_COLLISIONS_PER_WALK`]
-    /// collisions; each carried at most unit flux, so at most
-    /// `truncated / samples` of the incident flux is missing. Zero for paper.
+    /// Walks (over all channels) cut at [`SimConfig::max_collisions_per_walk`]
+    /// collisions; each carried at most unit flux, which is added to no
+    /// estimate, so at most `truncated / samples` of the incident flux is
+    /// missing (per channel, for a run with one distinct channel; the channels
+    /// of an RGB run add up). Zero for paper.
     pub truncated: u64,
     /// Largest `stderr / mean` over every estimate with a positive mean (0 when none).
     pub worst_rel_stderr: f64,
@@ -156,7 +165,7 @@ pub struct Totals {
     pub transmittance: Estimate,
     /// Walks run per colour channel.
     pub samples: u64,
-    /// Walks cut at [`MAX_COLLISIONS_PER_WALK`] collisions (see [`BsdfRun::truncated`]).
+    /// Walks cut at [`SimConfig::max_collisions_per_walk`] collisions (see [`BsdfRun::truncated`]).
     pub truncated: u64,
     /// Largest `stderr / mean` over the estimates with a positive mean.
     pub worst_rel_stderr: f64,
@@ -208,6 +217,13 @@ fn check_config(c: &SimConfig) -> Result<(), SimError> {
             name: "samples",
             value: 0.0,
             message: "need at least one walk",
+        });
+    }
+    if c.max_collisions_per_walk == 0 {
+        return Err(SimError::BadConfig {
+            name: "max_collisions_per_walk",
+            value: 0.0,
+            message: "allowed range is 1 to 18446744073709551615 collisions per walk (default 1e7)",
         });
     }
     if let Some(x) = c.rel_stderr {
@@ -297,7 +313,8 @@ fn run(slab: &Slab, inc: Incidence, wos: &[DVec3], cfg: &SimConfig, pb: &Progres
 
     let run_batch = |c: usize, b: u64| -> Vec<f64> {
         let mut rng = Pcg64Mcg::seed_from_u64(mix(cfg.seed ^ mix(key ^ mix(((c as u64) << 48) ^ b))));
-        let tracer = Tracer::with_exit_pool(slab, c, wos, exit_pool_size(per_batch), &mut rng);
+        let tracer = Tracer::with_exit_pool(slab, c, wos, exit_pool_size(per_batch), &mut rng)
+            .with_max_collisions(usize::try_from(cfg.max_collisions_per_walk).unwrap_or(usize::MAX));
         let tr = &tracer;
         let (mut sum, mut one) = if cfg.by_order {
             (Tally::with_orders(n), Tally::with_orders(n))
@@ -526,10 +543,16 @@ pub struct Work {
 /// half-space (`P(N > n) ~ n^-1/2`) cost about `2 sqrt(MAX_COLLISIONS_PER_WALK)`.
 /// An order-of-magnitude model, checked to a factor of 3 in `tests/limits.rs`.
 pub fn collisions_per_walk(m: crate::slab::Medium, d: f64, eta: f64) -> f64 {
+    collisions_per_walk_capped(m, d, eta, MAX_COLLISIONS_PER_WALK as u64)
+}
+
+/// [`collisions_per_walk`] with walks cut at `cap` collisions.
+fn collisions_per_walk_capped(m: crate::slab::Medium, d: f64, eta: f64, cap: u64) -> f64 {
     let tau = m.sigma_t * d;
     let returns = eta.max(1.0).powi(2);
     let absorb = 6.0 / (1.0 - m.albedo).max(f64::MIN_POSITIVE);
-    let cap = 2.0 * (MAX_COLLISIONS_PER_WALK as f64).sqrt();
+    // A walk never exceeds the cap itself.
+    let cap = (2.0 * (cap as f64).sqrt()).min(cap as f64);
     1.0 + (m.albedo * tau * returns).min(absorb).min(cap)
 }
 
@@ -539,7 +562,10 @@ pub fn estimate_work(slab: &Slab, cfg: &SimConfig, n_dirs: usize) -> Work {
     let channels = (0..3).filter(|&c| reps[c] == c).count() as f64;
     let per_walk = (0..3)
         .filter(|&c| reps[c] == c)
-        .map(|c| collisions_per_walk(slab.medium(c), slab.d, slab.sheet.front.eta.max(slab.sheet.back.eta)))
+        .map(|c| {
+            let eta = slab.sheet.front.eta.max(slab.sheet.back.eta);
+            collisions_per_walk_capped(slab.medium(c), slab.d, eta, cfg.max_collisions_per_walk.max(1))
+        })
         .fold(0.0, f64::max);
     let nb = cfg.batches.max(1) as u64;
     let first = cfg.samples.div_ceil(nb).max(1) * nb;

@@ -92,11 +92,13 @@ use std::f64::consts::PI;
 /// Weight below which Russian roulette is played.
 const RR_THRESHOLD: f64 = 0.01;
 
-/// Scattering events after which a walk is cut (counted in [`Tally::truncated`]).
-/// A walk in a nearly conservative slab of optical thickness `tau` takes about
-/// `tau^2` collisions to cross it, so this cuts nothing below `tau` of about
-/// 3000, far beyond paper (`tau` of 10 to 100); it bounds the work of absurd
-/// inputs (`sigma_s = 1e308`), whose walks have a heavy-tailed length.
+/// Default number of scattering events after which a walk is cut (counted in
+/// [`Tally::truncated`]; [`Tracer::with_max_collisions`] and
+/// [`crate::SimConfig::max_collisions_per_walk`] set another cap). A walk in a
+/// nearly conservative slab of optical thickness `tau` takes about `tau^2`
+/// collisions to cross it, so this cuts nothing below `tau` of about 3000, far
+/// beyond paper (`tau` of 10 to 100); it bounds the work of absurd inputs
+/// (`sigma_s = 1e308`), whose walks have a heavy-tailed length.
 pub const MAX_COLLISIONS_PER_WALK: usize = 10_000_000;
 /// Next-event contributions whose bound is below this are subject to Russian
 /// roulette (played with survival probability bound / NEE_RR_SCALE): deep
@@ -176,8 +178,10 @@ pub struct Tally {
     pub t: f64,
     /// Number of scattering events (collisions with scattering) in the walk(s).
     pub collisions: u64,
-    /// Walks cut at [`MAX_COLLISIONS_PER_WALK`] (their remaining flux, at most
-    /// their weight of 1 each, is missing from every estimate).
+    /// Walks cut at the tracer's collision cap ([`Tracer::max_collisions`],
+    /// [`MAX_COLLISIONS_PER_WALK`] by default). A cut walk ends there: its
+    /// remaining flux (its weight at the cut, at most 1 each) is added to
+    /// neither `r`, `t` nor `f`, so it is missing from every estimate.
     pub truncated: u64,
     /// When `Some`, the contributions to `f` split by the number of volume
     /// scattering events on the path: `[0, 1, 2 or more]` per viewing direction
@@ -263,6 +267,8 @@ pub struct Tracer<'a> {
     lobes: Vec<(f64, f64, bool)>,
     /// Whether any rough target uses MIS at volume vertices.
     any_mis_volume: bool,
+    /// Scattering events after which a walk is cut (at least 1).
+    max_collisions: usize,
 }
 
 impl<'a> Tracer<'a> {
@@ -329,6 +335,7 @@ impl<'a> Tracer<'a> {
             delta_lobes,
             lobes,
             any_mis_volume: false,
+            max_collisions: MAX_COLLISIONS_PER_WALK,
         };
         // The scale of each rough exit for Russian roulette, from a fixed set of draws.
         // Whether the phase function's peak is comparable to the exit lobe's
@@ -370,6 +377,20 @@ impl<'a> Tracer<'a> {
             tg.pool = draw_exits(tg, size, rng);
         }
         t
+    }
+
+    /// The tracer with walks cut after `cap` scattering events instead of
+    /// [`MAX_COLLISIONS_PER_WALK`] (a cap of 0 is taken as 1: the first
+    /// collision ends the walk). Each cut walk is counted in
+    /// [`Tally::truncated`] and its remaining flux is dropped.
+    pub fn with_max_collisions(mut self, cap: usize) -> Self {
+        self.max_collisions = cap.max(1);
+        self
+    }
+
+    /// Scattering events after which a walk is cut.
+    pub fn max_collisions(&self) -> usize {
+        self.max_collisions
     }
 
     /// Number of viewing directions.
@@ -741,7 +762,7 @@ impl<'a> Tracer<'a> {
                 }
                 tally.collisions += 1;
                 tally.order += 1;
-                if tally.order >= MAX_COLLISIONS_PER_WALK {
+                if tally.order >= self.max_collisions {
                     tally.truncated += 1;
                     return;
                 }
