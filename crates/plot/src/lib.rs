@@ -382,7 +382,11 @@ pub fn linear_ticks(lo: f64, hi: f64, n: usize) -> Vec<f64> {
     (first..=last).map(|k| k as f64 * step).collect()
 }
 
-fn register_font() {
+/// Registers the bundled DejaVu Sans as plotters' `sans-serif` (once per
+/// process). Anything that draws text with plotters in this workspace must
+/// call it first: with plotters' `ab_glyph` text backend there is no system
+/// font lookup, and text fails with `FontUnavailable`.
+pub fn register_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         static FONT: &[u8] = include_bytes!("../fonts/DejaVuSans.ttf");

@@ -203,6 +203,7 @@ fn component_errors(points: &[&Point], nc: usize) -> [f64; 3] {
 const ORDER_NAMES: [&str; 3] = ["surface/unscattered", "single", "multiple"];
 
 fn plot(path: &str, title: &str, res: &[AngleResult], rgb: bool) -> Result<(), Box<dyn std::error::Error>> {
+    paperbsdf_plot::register_font();
     let root = SVGBackend::new(path, (1200, 900)).into_drawing_area();
     root.fill(&WHITE)?;
     let root = root.titled(title, ("sans-serif", 22))?;
