@@ -4,9 +4,7 @@
 
 use crate::cmd_eval::{check_angles, MAX_EVAL_ANGLES};
 use anyhow::{anyhow, bail, Result};
-use paperbsdf_core::geometry::in_plane_directions;
-use paperbsdf_core::Bsdf;
-use paperbsdf_fit::measured::PointFilter;
+use paperbsdf_fit::measured::{sample_in_plane, PointFilter};
 
 /// Arguments of `paperbsdf convert`.
 #[derive(clap::Args, Debug)]
@@ -46,18 +44,12 @@ pub fn run(a: ConvertArgs) -> Result<()> {
         a.file, b.description
     );
     text.push_str("kind,theta_i_deg,theta_o_deg,r,g,b\n");
-    let mut rows = 0;
-    for &ti in &a.theta_i {
-        for &o in &to {
-            let (wi, wo) = in_plane_directions(ti, o, false);
-            if !filter.keeps(wi, wo) {
-                continue;
-            }
-            let v = b.eval(wi, wo);
-            text.push_str(&format!("R,{ti},{o},{:.9e},{:.9e},{:.9e}\n", v.0[0], v.0[1], v.0[2]));
-            rows += 1;
-        }
+    let points = sample_in_plane(&b, &a.theta_i, &to, &filter);
+    for p in &points {
+        let (ti, o, v) = (p.theta_i, p.theta_o.unwrap_or_default(), p.f);
+        text.push_str(&format!("R,{ti},{o},{:.9e},{:.9e},{:.9e}\n", v.0[0], v.0[1], v.0[2]));
     }
+    let rows = points.len();
     if rows == 0 {
         bail!("every angle pair was left out by --exclude-retro / --max-theta: nothing to write");
     }

@@ -123,6 +123,23 @@ pub fn sample_measured(b: &MeasuredBsdf, s: &Sampling) -> Vec<Point> {
     pts
 }
 
+/// In-plane slices of `b`: reflection points at every incident angle of
+/// `theta_i` and signed viewing angle of `theta_o` (degrees, DESIGN.md
+/// section 2) that `filter` keeps, in that order; what `paperbsdf convert`
+/// writes and `paperbsdf plot` draws for a `.bsdf` file.
+pub fn sample_in_plane(b: &MeasuredBsdf, theta_i: &[f64], theta_o: &[f64], filter: &PointFilter) -> Vec<Point> {
+    let mut pts = Vec::new();
+    for &ti in theta_i {
+        for &to in theta_o {
+            let (wi, wo) = in_plane_directions(ti, to, false);
+            if filter.keeps(wi, wo) {
+                pts.push(point(b, ti, Some(to), wi, wo));
+            }
+        }
+    }
+    pts
+}
+
 fn point(b: &MeasuredBsdf, ti: f64, to: Option<f64>, wi: DVec3, wo: DVec3) -> Point {
     Point {
         kind: Kind::R,

@@ -3,8 +3,9 @@
 //! Every material resolves, per hit, to a [`paperbsdf_core::Bsdf`] in the local
 //! frame whose `+z` is the shading normal (the front of a paper sheet), so the
 //! integrator sees one interface for the Lambertian, rough dielectric (Walter et
-//! al. 2007, `paperbsdf_core::RoughDielectric`) and Paper (Papas et al. 2014)
-//! BSDFs.
+//! al. 2007, `paperbsdf_core::RoughDielectric`), Paper (Papas et al. 2014) and
+//! measured (an RGL `.bsdf` file, `paperbsdf_io::MeasuredBsdf`: front-side
+//! reflection only) BSDFs.
 //!
 //! Paper maps: a thickness map scales `d` (a watermark is thinner paper) and
 //! an ink map adds absorption `sigma_a` (print). Building a Paper BSDF is not
@@ -203,7 +204,7 @@ pub enum Material {
         /// Reflectance.
         reflectance: ColourTexture,
     },
-    /// A fixed BSDF everywhere (e.g. a rough dielectric).
+    /// A fixed BSDF everywhere (a rough dielectric, or a measured RGL `.bsdf` BRDF, which is black from behind).
     Fixed(Arc<dyn Bsdf>),
     /// A paper sheet.
     Paper(Box<PaperMaterial>),

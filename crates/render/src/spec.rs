@@ -176,9 +176,11 @@ pub struct InkMapSpec {
 #[derive(Deserialize, Debug, Default)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
-    /// `diffuse`, `dielectric`, `paper` or `black`.
+    /// `diffuse`, `dielectric`, `paper`, `measured` or `black`.
     #[serde(rename = "type")]
     pub kind: String,
+    /// measured: an RGL `.bsdf` file (RGB variant), relative to the scene file.
+    pub file: Option<String>,
     /// diffuse: reflectance in [0, 1].
     pub reflectance: Option<ColourSpec>,
     /// dielectric: relative index of refraction (inside over outside), [1, 5].
@@ -306,6 +308,16 @@ impl Resources {
         }
         let p = self.base_dir.join(rel);
         Image::load(&p, grey).map(Arc::new)
+    }
+
+    /// Reads a measured RGL `.bsdf` file (embedded, else relative to the base directory);
+    /// the error names the file's path and what is wrong with it.
+    fn measured(&self, rel: &str) -> Result<paperbsdf_io::MeasuredBsdf, String> {
+        if let Some(b) = self.embedded.get(rel) {
+            return paperbsdf_io::MeasuredBsdf::from_bytes(b.to_vec(), rel).map_err(|e| e.to_string());
+        }
+        let p = self.base_dir.join(rel);
+        paperbsdf_io::MeasuredBsdf::load(&p).map_err(|e| e.to_string())
     }
 }
 
@@ -517,8 +529,9 @@ fn grey_image(
 
 /// Keys set in a material table that do not belong to its type.
 fn foreign_keys(m: &MaterialSpec, allowed: &[&str]) -> Vec<&'static str> {
-    let present: [(&'static str, bool); 21] = [
+    let present: [(&'static str, bool); 22] = [
         ("reflectance", m.reflectance.is_some()),
+        ("file", m.file.is_some()),
         ("params", m.params.is_some()),
         ("eta", m.eta.is_some()),
         ("m", m.m.is_some()),
@@ -695,12 +708,13 @@ fn material(name: &str, m: &MaterialSpec, file: &str, res: &Resources) -> Result
             "thickness_map",
             "ink_map",
         ],
+        "measured" => &["file"],
         "black" => &[],
         other => {
             return Err(err(
                 file,
                 entry,
-                format!("unknown material type `{other}` (allowed: diffuse, dielectric, paper, black)"),
+                format!("unknown material type `{other}` (allowed: diffuse, dielectric, paper, measured, black)"),
             ))
         }
     };
@@ -767,6 +781,16 @@ fn material(name: &str, m: &MaterialSpec, file: &str, res: &Resources) -> Result
             let pm = PaperMaterial::new(p, thickness, ink, paper_model::paper_bsdf)
                 .map_err(|e| err(file, entry, e.to_string()))?;
             Material::Paper(Box::new(pm))
+        }
+        "measured" => {
+            let rel = m
+                .file
+                .as_ref()
+                .ok_or_else(|| err(file, entry, "measured needs `file` (an RGL .bsdf file)"))?;
+            let b = res
+                .measured(rel)
+                .map_err(|e| err(file, entry, format!("`file`: {e}")))?;
+            Material::Fixed(Arc::new(b))
         }
         _ => Material::Black,
     })
