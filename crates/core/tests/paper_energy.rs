@@ -354,10 +354,13 @@ fn white_furnace() {
             }
             (bad, worst)
         })
-        .reduce(|| (Vec::new(), 0.0), |mut a, b| {
-            a.0.extend(b.0);
-            (a.0, a.1.max(b.1))
-        });
+        .reduce(
+            || (Vec::new(), 0.0),
+            |mut a, b| {
+                a.0.extend(b.0);
+                (a.0, a.1.max(b.1))
+            },
+        );
     eprintln!("white furnace: 160 sheets x 5 angles x 2 sides x 2 integrals, worst |R + T - 1| = {worst:.2e}");
     assert!(bad.is_empty(), "{} furnace violations:\n{}", bad.len(), bad.join("\n"));
 }
