@@ -307,10 +307,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .parse()
                     .map_err(|e| format!("--face-scattering: {e}"))?
             }
-            _ => return Err(format!(
+            _ => {
+                return Err(format!(
                 "unknown argument `{a}` (use --walks N, --out-dir DIR, --only CASE, --face-scattering single|multiple)"
             )
-            .into()),
+                .into())
+            }
         }
     }
     let t_start = std::time::Instant::now();
