@@ -274,8 +274,8 @@ fn edge_multipole_is_the_models() {
             let b = PaperBsdf::new(&p).unwrap();
             let mps = sheet_multipoles(&b, &p).unwrap();
             let (rd, td) = b.multipole_rd_td(0);
-            for c in 0..3 {
-                let (r, t) = mps[c].rd_td();
+            for (c, mp) in mps.iter().enumerate() {
+                let (r, t) = mp.rd_td();
                 assert!(
                     (r - rd.0[c]).abs() < 1e-12 && (t - td.0[c]).abs() < 1e-12,
                     "{fs:?} eta_f {eta_f} channel {c}: edge ({r}, {t}) vs model ({}, {})",
