@@ -340,7 +340,7 @@ pub fn fit_datasheet(ds: &Datasheet) -> Result<DatasheetFit, DatasheetError> {
                 for c in 0..3 {
                     if trinf[c] > rmax[c] + 5e-4 {
                         return Err(DatasheetError::Unreachable(format!(
-                            "pad reflectance {:.1} % in the {} channel (brightness {brightness} %{}): a non-absorbing sheet with these faces reflects at most {:.1} %; more needs fluorescent whitening (or faces that lose less light)",
+                            "pad reflectance {:.1} % in the {} channel (brightness {brightness} %{}): a non-absorbing sheet with these faces reflects at most {:.1} %; more needs fluorescent whitening",
                             100.0 * trinf[c],
                             channel[c],
                             if ds.tint.is_some() { " with the tint" } else { "" },

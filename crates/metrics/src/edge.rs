@@ -17,7 +17,9 @@
 //! - **Model**: the multipole reflectance profile `R(r)` (supplement eq. 1,
 //!   Donner & Jensen 2005) that the model's multiple-scattering term
 //!   integrates to `R_d`, built from [`paperbsdf_core::paper::multipole::Multipole`]
-//!   with the faces' internal diffuse reflectances; it carries the model's
+//!   with the internal diffuse reflectances of the model's own faces
+//!   ([`sheet_multipoles`]: energy-compensated for `face_scattering =
+//!   "multiple"`, the default, and with a front coating's boundary); it carries the model's
 //!   multiple-scattering albedo at normal incidence (from
 //!   `eval_component(.., Multiple)`), and the rest of the model's reflectance
 //!   (surface and single scattering, which the BSDF places at the point of
@@ -27,12 +29,12 @@
 //! weighted by `Y_c R_c`).
 
 use crate::instrument::Y_WEIGHTS;
-use paperbsdf_core::boundary::SurfaceIntegrals;
 use paperbsdf_core::models::ComponentModel;
 use paperbsdf_core::paper::multipole::Multipole;
-use paperbsdf_core::paper::Component;
+use paperbsdf_core::paper::{Component, PaperBsdf};
 use paperbsdf_core::quadrature::gauss_legendre_01;
-use paperbsdf_core::{DVec3, PaperParams, Rgb, RoughDielectric};
+use paperbsdf_core::sheet::Sheet;
+use paperbsdf_core::{DVec3, PaperParams, Rgb};
 
 /// 5-95 % width of the instrument blur of the supplement (brushed metal), mm.
 pub const SUPPLEMENT_BLUR_MM: f64 = 0.2;
@@ -219,20 +221,23 @@ fn tail(tab: &RadialTable, x: f64, nodes: &(Vec<f64>, Vec<f64>)) -> f64 {
     s
 }
 
-/// The multipole of a sheet for light entering its front face: reduced
-/// scattering and absorption of each channel, the faces' internal diffuse
-/// reflectances `rho_in` (tabulated integrals of the faces' Walter BSDFs).
-pub fn sheet_multipoles(p: &PaperParams) -> Option<[Multipole; 3]> {
-    p.validate().ok()?;
-    let rho = |dist, eta, m| -> Option<f64> {
-        let b = RoughDielectric::new(dist, eta, m).ok()?;
-        Some(SurfaceIntegrals::new(&b).rho_in)
-    };
-    let (rf, rb) = (rho(p.dist_f, p.eta_f, p.m_f)?, rho(p.dist_b, p.eta_b, p.m_b)?);
-    let g = p.w_b * p.g_b + (1.0 - p.w_b) * p.g_f;
-    let (sa, ss) = (p.sigma_a.rgb(), p.sigma_s.rgb());
+/// The multipoles (one per channel) of a sheet for light entering its front
+/// face, as the Paper BSDF's multiple-scattering term builds them: reduced
+/// scattering `sigma_s (1 - g)` (`g` the phase function's mean cosine) and
+/// absorption of each channel, and the internal diffuse reflectances `rho_in`
+/// of `paper`'s own faces ([`PaperBsdf::face_inside_hemispherical`]): Walter's
+/// interface for `face_scattering = "single"`, with the energy compensation
+/// for `"multiple"`, and over a front coating's smooth boundary when
+/// `eta_f != eta_b`. `paper` must be the Paper BSDF of `p`.
+pub fn sheet_multipoles(paper: &PaperBsdf, p: &PaperParams) -> Option<[Multipole; 3]> {
+    let sheet = Sheet::from_params(p).ok()?;
+    let (rf, rb) = (
+        paper.face_inside_hemispherical(0).0,
+        paper.face_inside_hemispherical(1).0,
+    );
+    let sigma_s_p = sheet.sigma_s * (1.0 - sheet.phase.mean_cosine());
     let out: [Option<Multipole>; 3] =
-        std::array::from_fn(|c| Multipole::new((1.0 - g) * ss.0[c], sa.0[c], p.d, rf, rb));
+        std::array::from_fn(|c| Multipole::new(sigma_s_p.0[c], sheet.sigma_a.0[c], p.d, rf, rb));
     Some([out[0]?, out[1]?, out[2]?])
 }
 
@@ -263,10 +268,14 @@ fn multipole_cdf(m: &Multipole, x0: f64, h: f64, n: usize) -> Vec<f64> {
         .collect()
 }
 
-/// The model's edge profile (module doc): `model` is the Paper BSDF built from
-/// `p`. `None` when nothing scatters.
+/// The model's edge profile (module doc): `model` is a Paper BSDF built from
+/// `p` (the default one, or the reduced multilayer model); the multipole's
+/// faces are those of the sheet of `p` as [`PaperBsdf::new`] builds them
+/// (the internal reflectances do not depend on the options). `None` when
+/// nothing scatters or `p` is invalid.
 pub fn model_edge(model: &dyn ComponentModel, p: &PaperParams, half_width: f64, n: usize) -> Option<EdgeProfile> {
-    let mps = sheet_multipoles(p)?;
+    let paper = PaperBsdf::new(p).ok()?;
+    let mps = sheet_multipoles(&paper, p)?;
     // Reflectance at normal incidence: total (sampled albedo) and the multiple-scattering part.
     let (r_tot, _) = paperbsdf_core::bsdf::sampled_albedo(model, DVec3::Z, 128);
     let (x, w) = gauss_legendre_01(16);

@@ -125,12 +125,14 @@ fn opacity_limits() {
     // Optically thick: opaque.
     let thick = sheet(1.0, 3000.0, 0.1, 0.15);
     let o = opacity(&thick);
+    eprintln!("thick sheet: opacity {o:.4} %");
     assert!(o > 99.9, "thick sheet: opacity {o}");
     // Non-scattering, non-absorbing, index-matched: invisible (R0 = 0).
     let mut clear = sheet(0.1, 0.0, 0.0, 0.0);
     clear.eta_f = 1.0;
     clear.eta_b = 1.0;
     let o = opacity(&clear);
+    eprintln!("clear sheet: opacity {o:e} %");
     assert!(o.abs() < 1e-9, "clear sheet: opacity {o}");
     // Tends to 0 as scattering vanishes, and rises with it.
     let mut last = 0.0;
@@ -138,6 +140,7 @@ fn opacity_limits() {
         let mut p = clear.clone();
         p.sigma_s = Colour::Scalar(ss);
         let o = opacity(&p);
+        eprintln!("clear sheet with sigma_s {ss}: opacity {o:.4} %");
         assert!(o > last, "sigma_s {ss}: opacity {o} not above {last}");
         if ss == 0.01 {
             assert!(o < 0.1, "sigma_s 0.01: opacity {o}");
@@ -148,6 +151,7 @@ fn opacity_limits() {
     let mut last = 0.0;
     for d in [0.03, 0.05, 0.1, 0.2, 0.4] {
         let o = opacity(&sheet(d, 150.0, 0.2, 0.15));
+        eprintln!("caliper {d} mm: opacity {o:.2} %");
         assert!(o > last + 0.05, "d {d}: opacity {o} not above {last}");
         last = o;
     }

@@ -1,11 +1,12 @@
 //! The measurements against closed forms: reference glass and a perfect
 //! mirror (gloss), a Lambertian reflector over each receptor window (gloss
 //! quadrature), the Kubelka-Munk inversion, the multipole profile against its
-//! closed-form integral, and the blur of the edge profile.
+//! closed-form integral and against the model's own multipole, and the blur
+//! of the edge profile.
 
 use paperbsdf_core::paper::multipole::Multipole;
 use paperbsdf_core::{Bsdf, BsdfFlags, BsdfSample, Colour, DVec3, Distribution, PaperParams, Rgb};
-use paperbsdf_metrics::edge::{multipole_r, EdgeProfile};
+use paperbsdf_metrics::edge::{multipole_r, sheet_multipoles, EdgeProfile};
 use paperbsdf_metrics::gloss::{self, Window, GEOMETRIES};
 use paperbsdf_metrics::instrument;
 
@@ -94,6 +95,7 @@ fn reference_glass_is_100_gu() {
     for g in &GEOMETRIES {
         let b = if g.glass_index == 1.540 { &tappi } else { &astm };
         let v = gloss::gloss(b, g);
+        eprintln!("{}: reference glass of index {} reads {v:.3} GU", g.key, g.glass_index);
         assert!((v - 100.0).abs() <= 0.5, "{}: reference glass reads {v} GU", g.key);
     }
     // The other glass on a geometry is not 100: the measurement sees the index.
@@ -122,6 +124,7 @@ fn nearly_smooth_glass_reads_like_smooth_glass() {
 #[test]
 fn perfect_mirror_is_384_4_gu_at_75_degrees() {
     let v = gloss::gloss(&Mirror, &GEOMETRIES[0]);
+    eprintln!("perfect mirror at 75 deg: {v:.3} GU");
     assert!((v - 384.4).abs() <= 1.0, "mirror at 75 deg: {v} GU");
     // And 100 / F(theta) on the others (the scale's definition).
     for g in &GEOMETRIES[1..] {
@@ -238,6 +241,58 @@ fn multipole_profile_integrates_to_rd() {
             s += 2.0 * std::f64::consts::PI * r * multipole_r(&m, r) * dr;
         }
         assert!((s / rd - 1.0).abs() < 2e-3, "{ssp} {sa} {d}: integral {s} vs R_d {rd}");
+    }
+}
+
+/// The scatter distance's multipole is the one the Paper BSDF integrates:
+/// its `R_d`, `T_d` for light entering the front are the model's own, for
+/// Walter's and for energy-conserving faces, uncoated and coated (`eta_f !=
+/// eta_b`), and the faces' `rho_in` is the model's (the compensated faces
+/// reflect more inside than Walter's, so Walter's `rho_in` would not match).
+#[test]
+fn edge_multipole_is_the_models() {
+    use paperbsdf_core::{FaceScattering, PaperBsdf};
+    let mut walter_rho = None;
+    for fs in [FaceScattering::Single, FaceScattering::Multiple] {
+        for eta_f in [1.5, 1.7] {
+            let p = PaperParams {
+                name: None,
+                d: 0.1,
+                sigma_a: Colour::Rgb([0.12, 0.10, 0.07]),
+                sigma_s: Colour::Scalar(300.0),
+                g_f: 0.8,
+                g_b: -0.4,
+                w_b: 0.2,
+                eta_f,
+                eta_b: 1.5,
+                m_f: 0.3,
+                m_b: 0.4,
+                dist_f: Distribution::Ggx,
+                dist_b: Distribution::Beckmann,
+                face_scattering: fs,
+            };
+            let b = PaperBsdf::new(&p).unwrap();
+            let mps = sheet_multipoles(&b, &p).unwrap();
+            let (rd, td) = b.multipole_rd_td(0);
+            for (c, mp) in mps.iter().enumerate() {
+                let (r, t) = mp.rd_td();
+                assert!(
+                    (r - rd.0[c]).abs() < 1e-12 && (t - td.0[c]).abs() < 1e-12,
+                    "{fs:?} eta_f {eta_f} channel {c}: edge ({r}, {t}) vs model ({}, {})",
+                    rd.0[c],
+                    td.0[c]
+                );
+            }
+            let rho_f = b.face_inside_hemispherical(0).0;
+            match (fs, eta_f == 1.5) {
+                (FaceScattering::Single, true) => walter_rho = Some(rho_f),
+                (FaceScattering::Multiple, true) => {
+                    let w = walter_rho.unwrap();
+                    assert!(rho_f > w + 0.01, "compensated rho_in {rho_f} vs Walter's {w}");
+                }
+                _ => {}
+            }
+        }
     }
 }
 
