@@ -200,13 +200,16 @@ def test_fit_reproduces_the_fit_table(repo):
     res = paperbsdf.fit(os.path.join(repo, "data", "matte.csv"), "paper", thickness=0.11,
                         fit_theta_i=[0, 30, 60])
     assert res["model"] == "paper"
-    # docs/fit_table.md gave 0.0206 / 0.0602 with Walter's faces, with which
-    # data/matte.csv was simulated; the default faces are now energy-conserving
-    # (issue 14), and the table and the data are still to be regenerated with
-    # them. Until then: a good fit of the shape (0.057 / 0.06 measured), not
-    # the table's number.
-    assert res["rms_log_error"] < 0.1, res["rms_log_error"]
-    assert res["extrapolation_rms_log_error"] < 0.2, res["extrapolation_rms_log_error"]
+    # The same fit as the main job's row for matte/paper in docs/fit_table.md
+    # (data and table both made with the default energy-conserving faces).
+    # The fitter is deterministic; 10% + 1e-3 allows only for a different
+    # summation order, not for a worse fit.
+    row = next(l for l in open(os.path.join(repo, "docs", "fit_table.md"))
+               if l.startswith("| matte | paper |"))
+    want_fit, want_extrap = (float(v) for v in row.split("|")[3:5])
+    assert res["rms_log_error"] <= 1.1 * want_fit + 1e-3, (res["rms_log_error"], want_fit)
+    assert res["extrapolation_rms_log_error"] <= 1.1 * want_extrap + 1e-3, (
+        res["extrapolation_rms_log_error"], want_extrap)
     paperbsdf.PaperBsdf(res["params"])  # the fitted parameters load
 
 
