@@ -302,7 +302,9 @@ fn no_albedo_above_one_by_either_integral() {
 /// (unequal faces, so coatings too), thickness 0.02 to 1 mm, reflects and
 /// transmits exactly what arrives, from both faces, at 0 to 85 degrees.
 /// Tolerance: the 2e-3 asked of the model plus 3 standard errors of the
-/// estimate (about 1e-4 here).
+/// estimate. An estimate of 10 x 24 x 16^2 samples that is off by more than
+/// 2e-3 is measured again with 131072 samples (standard error about 2e-4 to
+/// 1e-3) and judged on that, so the printed worst deviation is a precise one.
 #[test]
 fn white_furnace() {
     let (bad, worst): (Vec<String>, f64) = (0..160u64)
@@ -341,7 +343,14 @@ fn white_furnace() {
                     let w = dir(deg.to_radians(), side, &mut rng);
                     for over in [Over::Wo, Over::Wi] {
                         let (r, t, se) = albedo(&b, w, over, 16, 24, rng.gen(), None);
-                        let a = (r + t).0[0];
+                        let seed2: u64 = rng.gen();
+                        let (mut r, mut t, mut se, mut a) = (r, t, se, (r + t).0[0]);
+                        if (a - 1.0).abs() > 2e-3 {
+                            // Re-measured independently and more precisely (as in
+                            // `check_energy`): 8 batches of 128 x 128 samples.
+                            (r, t, se) = albedo(&b, w, over, 128, 8, seed2, None);
+                            a = (r + t).0[0];
+                        }
                         worst = worst.max((a - 1.0).abs());
                         if (a - 1.0).abs() > 2e-3 + 3.0 * se.0[0] {
                             bad.push(format!(
