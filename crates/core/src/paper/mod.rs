@@ -649,15 +649,41 @@ impl PaperBsdf {
         let amp_i = fe.att_dir_with_sqrt(mu.min(1.0).sqrt());
         let c = DVec2::new(-wi.x, -wi.y);
         let sc = c.length();
+        // The attenuation exp(-tau / min(mu_i, mu_o)): where the exit is the
+        // steeper path (mu_o >= mu_i) it is the same for every point, computed
+        // once; a grey sheet needs one exponential, not three. Both give
+        // exactly the values of the direct per-point expression.
+        let attenuation = |mu_min: f64| -> Rgb {
+            if self.grey {
+                Rgb::splat((-self.tau.0[0] / mu_min).exp())
+            } else {
+                self.tau.map(|t| (-t / mu_min).exp())
+            }
+        };
+        let mu_i_min = mu_i.max(1e-300);
+        let att_i = attenuation(mu_i_min);
         let g = |p_o: DVec2| -> Rgb {
             let r2 = p_o.length_squared();
             if r2 >= 1.0 {
                 return Rgb::ZERO;
             }
             let mo = (1.0 - r2).sqrt();
-            let mu_min = mu_i.min(fx.inside_cos(mo)).max(1e-300);
-            self.tau.map(|t| (-t / mu_min).exp()) * (amp_i * fx.att_dir_with_sqrt(mo.sqrt()))
+            let mu_o = fx.inside_cos(mo);
+            let a = if mu_o >= mu_i {
+                att_i
+            } else {
+                attenuation(mu_i.min(mu_o).max(1e-300))
+            };
+            a * (amp_i * fx.att_dir_with_sqrt(mo.sqrt()))
         };
+        // The midpoint rule's directions on the circle, the same for every ring.
+        static RING: std::sync::OnceLock<[(f64, f64); ND]> = std::sync::OnceLock::new();
+        let ring_dirs = RING.get_or_init(|| {
+            std::array::from_fn(|j| {
+                let phi = std::f64::consts::TAU * (j as f64 + 0.5) / ND as f64;
+                (phi.cos(), phi.sin())
+            })
+        });
         let (u_full, u_max) = (self.kernel.cdf(1.0 - sc), self.kernel.cdf(1.0 + sc));
         let mut sum = Rgb::ZERO;
         for (xu, wu) in xg.iter().zip(wg) {
@@ -668,9 +694,8 @@ impl PaperBsdf {
                 continue;
             }
             let mut ring = Rgb::ZERO;
-            for j in 0..ND {
-                let phi = std::f64::consts::TAU * (j as f64 + 0.5) / ND as f64;
-                ring += g(c + r * DVec2::new(phi.cos(), phi.sin()));
+            for &(cp, sp) in ring_dirs {
+                ring += g(c + r * DVec2::new(cp, sp));
             }
             sum += ring * (wu * u_full / ND as f64);
             // The arc inside the disk.
