@@ -82,12 +82,20 @@ fn lerp_t(tab: &[f64; NA], mu: f64) -> f64 {
     lerp_sqrt(tab, mu.abs().min(1.0).sqrt())
 }
 
+/// The interval `i` of the [`NA`] node tables that holds `st` (in `[0, 1]`)
+/// and the fraction `f` of the way from node `i` to `i + 1`: the weights of
+/// every linear interpolation of those tables.
+#[inline]
+pub(crate) fn node_at(st: f64) -> (usize, f64) {
+    let x = st * (NA - 1) as f64;
+    let i = (x as usize).min(NA - 2);
+    (i, x - i as f64)
+}
+
 /// Linear interpolation of a node table at `mu = st^2` for a precomputed `st = sqrt(min(|mu|, 1))`.
 #[inline]
 pub(crate) fn lerp_sqrt(tab: &[f64; NA], st: f64) -> f64 {
-    let x = st * (NA - 1) as f64;
-    let i = (x as usize).min(NA - 2);
-    let f = x - i as f64;
+    let (i, f) = node_at(st);
     tab[i] * (1.0 - f) + tab[i + 1] * f
 }
 
@@ -624,9 +632,7 @@ impl Face {
     #[inline]
     pub fn lobes_reflection(&self, si: f64, so: f64) -> f64 {
         let node = |st: f64| {
-            let x = st * (NA - 1) as f64;
-            let i = (x as usize).min(NA - 2);
-            let f = x - i as f64;
+            let (i, f) = node_at(st);
             let (a, b) = (self.lobe_tab[i], self.lobe_tab[i + 1]);
             [a[0] * (1.0 - f) + b[0] * f, a[1] * (1.0 - f) + b[1] * f]
         };

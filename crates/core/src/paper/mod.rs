@@ -243,9 +243,7 @@ fn lerp_tab_sqrt(tab: &[Rgb; NS], st: f64) -> Rgb {
 /// [`lerp_sqrt`] of an RGB table on the face nodes, channel by channel.
 #[inline(always)]
 fn lerp_rgb_sqrt(tab: &[Rgb; NA], st: f64) -> Rgb {
-    let x = st * (NA - 1) as f64;
-    let i = (x as usize).min(NA - 2);
-    let f = x - i as f64;
+    let (i, f) = face::node_at(st);
     tab[i] * (1.0 - f) + tab[i + 1] * f
 }
 
@@ -660,8 +658,7 @@ impl PaperBsdf {
                 self.tau.map(|t| (-t / mu_min).exp())
             }
         };
-        let mu_i_min = mu_i.max(1e-300);
-        let att_i = attenuation(mu_i_min);
+        let att_i = attenuation(mu_i.max(1e-300));
         let g = |p_o: DVec2| -> Rgb {
             let r2 = p_o.length_squared();
             if r2 >= 1.0 {
