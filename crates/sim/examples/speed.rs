@@ -41,9 +41,11 @@ fn main() {
     let rel = r.f[0].stderr.0[0] / r.f[0].mean.0[0];
     let k = (rel / 0.01).powi(2);
     println!("{name} R(30,0) = {:.5} +- {:.5} ({:.2}%) with {} walks: wall {:.3} s, cpu {:.3} s; to 1%: wall {:.3} s, cpu {:.3} s", r.f[0].mean.0[0], r.f[0].stderr.0[0], 100.0 * rel, r.samples, dt, cpu, dt * k, cpu * k);
+    let reps = slab.distinct_channels();
+    let channels = (0..3).filter(|&c| reps[c] == c).count() as u64;
     println!(
         "collisions per walk: {:.1}",
-        paperbsdf_sim::estimate::collisions_so_far() as f64 / r.samples as f64
+        r.collisions as f64 / (r.samples * channels) as f64
     );
     if !args.iter().skip(3).any(|a| a == "adaptive") {
         return;

@@ -34,13 +34,6 @@ fn exit_pool_size(walks_per_batch: u64) -> usize {
     (walks_per_batch.saturating_mul(8)).clamp(256, 4096) as usize
 }
 
-static COLLISIONS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-
-/// Total number of scattering events simulated by this process so far (a diagnostic).
-pub fn collisions_so_far() -> u64 {
-    COLLISIONS.load(std::sync::atomic::Ordering::Relaxed)
-}
-
 /// Largest number of batches (each holds a vector of means; more batches add
 /// nothing to the standard error's accuracy, which is already 1 part in 300).
 pub const MAX_BATCHES: u32 = 100_000;
@@ -149,6 +142,9 @@ pub struct BsdfRun {
     /// missing (per channel, for a run with one distinct channel; the channels
     /// of an RGB run add up). Zero for paper.
     pub truncated: u64,
+    /// Volume scattering events simulated by the run, over all channels
+    /// (`collisions / (samples * distinct channels)` is the mean per walk).
+    pub collisions: u64,
     /// Largest `stderr / mean` over every estimate with a positive mean (0 when none).
     pub worst_rel_stderr: f64,
     /// With [`SimConfig::rel_stderr`]: whether the target was reached (else
@@ -167,6 +163,8 @@ pub struct Totals {
     pub samples: u64,
     /// Walks cut at [`SimConfig::max_collisions_per_walk`] collisions (see [`BsdfRun::truncated`]).
     pub truncated: u64,
+    /// Volume scattering events simulated by the run (see [`BsdfRun::collisions`]).
+    pub collisions: u64,
     /// Largest `stderr / mean` over the estimates with a positive mean.
     pub worst_rel_stderr: f64,
     /// Whether the `rel_stderr` target was reached (see [`BsdfRun::target_reached`]).
@@ -281,6 +279,7 @@ fn incidence_key(inc: Incidence) -> u64 {
 struct RunStats {
     samples: u64,
     truncated: u64,
+    collisions: u64,
     worst_rel_stderr: f64,
     target_reached: bool,
 }
@@ -302,6 +301,7 @@ fn worst_rel(est: &[Estimate]) -> f64 {
 /// channel, each a vector `[f_0, .., f_{n-1}, R, T]`.
 fn run(slab: &Slab, inc: Incidence, wos: &[DVec3], cfg: &SimConfig, pb: &ProgressBar) -> (Vec<Estimate>, RunStats) {
     let truncated = std::sync::atomic::AtomicU64::new(0);
+    let collisions = std::sync::atomic::AtomicU64::new(0);
     let reps = slab.distinct_channels();
     let channels: Vec<usize> = (0..3).filter(|&c| reps[c] == c).collect();
     let nb = cfg.batches as u64;
@@ -344,7 +344,7 @@ fn run(slab: &Slab, inc: Incidence, wos: &[DVec3], cfg: &SimConfig, pb: &Progres
             }
         }
         pb.inc(per_batch % 256);
-        COLLISIONS.fetch_add(sum.collisions, std::sync::atomic::Ordering::Relaxed);
+        collisions.fetch_add(sum.collisions, std::sync::atomic::Ordering::Relaxed);
         truncated.fetch_add(sum.truncated, std::sync::atomic::Ordering::Relaxed);
         let inv = 1.0 / per_batch as f64;
         let mut v: Vec<f64> = sum.f.iter().map(|x| x * inv).collect();
@@ -377,6 +377,7 @@ fn run(slab: &Slab, inc: Incidence, wos: &[DVec3], cfg: &SimConfig, pb: &Progres
         let stats = |reached: bool| RunStats {
             samples: done_batches * per_batch,
             truncated: truncated.load(std::sync::atomic::Ordering::Relaxed),
+            collisions: collisions.load(std::sync::atomic::Ordering::Relaxed),
             worst_rel_stderr: achieved,
             target_reached: reached,
         };
@@ -492,6 +493,7 @@ pub fn simulate_bsdf(slab: &Slab, wi: DVec3, wos: &[DVec3], cfg: &SimConfig) -> 
         by_order,
         samples: st.samples,
         truncated: st.truncated,
+        collisions: st.collisions,
         worst_rel_stderr: st.worst_rel_stderr,
         target_reached: st.target_reached,
     })
@@ -513,6 +515,7 @@ pub fn simulate_totals(slab: &Slab, inc: Incidence, cfg: &SimConfig) -> Result<T
         transmittance: est[1],
         samples: st.samples,
         truncated: st.truncated,
+        collisions: st.collisions,
         worst_rel_stderr: st.worst_rel_stderr,
         target_reached: st.target_reached,
     })

@@ -11,7 +11,7 @@
 
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::PaperParams;
-use paperbsdf_sim::estimate::{collisions_so_far, estimate_work};
+use paperbsdf_sim::estimate::estimate_work;
 use paperbsdf_sim::walk::{Tally, Tracer, MAX_COLLISIONS_PER_WALK};
 use paperbsdf_sim::{simulate_totals, Incidence, SimConfig, SimError, Slab};
 use rand::SeedableRng;
@@ -106,9 +106,8 @@ fn cap_cuts_walks_quickly_and_their_flux_is_missing() {
     };
     let (wi, _) = in_plane_directions(30.0, 0.0, false);
     let start = Instant::now();
-    let before = collisions_so_far();
     let t = simulate_totals(&s, Incidence::Collimated(wi), &cfg).unwrap();
-    let collisions = collisions_so_far() - before;
+    let collisions = t.collisions;
     let elapsed = start.elapsed();
     eprintln!(
         "{} of {} walks cut, {collisions} collisions ({:.1} per walk, predicted {:.1}) in {elapsed:?}",
