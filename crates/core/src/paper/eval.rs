@@ -1,0 +1,279 @@
+//! Evaluation of the Paper BSDF and of its sampling density: the components
+//! of the module doc of [`super`] for a pair of directions, from the tables
+//! of [`super::build`], with the geometry (inside cosines, phase function)
+//! that `eval` and `pdf` share.
+
+use super::build::{lerp_rgb_sqrt, NP};
+use super::face::to_face_frame;
+use super::{grazing, side, single, Component, ComponentSet, PaperBsdf, TAU_DROP};
+use crate::spectrum::Rgb;
+use glam::{DVec2, DVec3};
+use std::f64::consts::PI;
+
+/// Geometry shared by `eval` and `pdf`: inside cosines of `wi` and `wo` and
+/// the mixture phase function between the inside directions (0 if not asked).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Inside {
+    pub(super) mu_i: f64,
+    pub(super) mu_o: f64,
+    /// `sqrt(min(|wi.z|, 1))`, `sqrt(min(|wo.z|, 1))` outside: the coordinates of the face tables.
+    pub(super) si: f64,
+    pub(super) so: f64,
+    /// The phase function as `p_num / p_den` (`p_num = 0`, `p_den = 1` if not asked).
+    pub(super) p_num: f64,
+    pub(super) p_den: f64,
+}
+
+impl PaperBsdf {
+    /// The mixture phase function (non-degenerate lobes) at cosine `cos`, as
+    /// `(numerator, denominator)` for callers that fold the division into
+    /// their own: `w HG(cos; g) = k / (q sqrt(q))`, `q = 1 + g^2 - 2 g cos`,
+    /// both lobes over one denominator (an absent lobe has `k = 0`, `q = 1`).
+    #[inline]
+    pub(super) fn phase_ratio(&self, cos: f64) -> (f64, f64) {
+        let [(k0, a0, b0), (k1, a1, b1)] = self.lobe_hg;
+        let (q0, q1) = (a0 - b0 * cos, a1 - b1 * cos);
+        let (d0, d1) = (q0 * q0.sqrt(), q1 * q1.sqrt());
+        (k0 * d1 + k1 * d0, d0 * d1)
+    }
+
+    /// Inside propagation directions `(t_i, t_o)` and cosines for outside `wi`, `wo`.
+    #[inline(always)]
+    pub(super) fn inside_dirs(&self, wi: DVec3, wo: DVec3) -> (DVec3, DVec3, f64, f64) {
+        let (fe, fx) = (&self.faces[side(wi)], &self.faces[side(wo)]);
+        let mu_i = fe.inside_cos(wi.z.abs());
+        let mu_o = fx.inside_cos(wo.z.abs());
+        let t_i = DVec3::new(-wi.x * fe.inv_n(), -wi.y * fe.inv_n(), -wi.z.signum() * mu_i);
+        let t_o = DVec3::new(wo.x * fx.inv_n(), wo.y * fx.inv_n(), wo.z.signum() * mu_o);
+        (t_i, t_o, mu_i, mu_o)
+    }
+
+    /// Inside cosines of `wi`, `wo` and (if `want_phase`) the phase function
+    /// between the inside directions: what `eval` and `pdf` share.
+    #[inline(always)]
+    pub(super) fn inside(&self, wi: DVec3, wo: DVec3, want_phase: bool, (si, so): (f64, f64)) -> Inside {
+        let (t_i, t_o, mu_i, mu_o) = self.inside_dirs(wi, wo);
+        let (p_num, p_den) = if want_phase && self.lobe_sum > 0.0 {
+            self.phase_ratio(t_i.dot(t_o).clamp(-1.0, 1.0))
+        } else {
+            (0.0, 1.0)
+        };
+        Inside {
+            mu_i,
+            mu_o,
+            si,
+            so,
+            p_num,
+            p_den,
+        }
+    }
+
+    /// Sum of the components in `set` (no cosine; delta lobes excluded).
+    pub fn eval_components(&self, wi: DVec3, wo: DVec3, set: ComponentSet) -> Rgb {
+        self.eval_with(wi, wo, set, None, None)
+    }
+
+    /// [`PaperBsdf::eval_components`] with the shared geometry `pre` and the
+    /// face's reflection `surface` if the caller has them.
+    ///
+    /// Always inlined: returned through memory, its `Rgb` (written channel by
+    /// channel) was read back by the caller with wider loads that could not be
+    /// forwarded from those stores, a stall of about 20 ns in `sample`.
+    #[inline(always)]
+    pub(super) fn eval_with(
+        &self,
+        wi: DVec3,
+        wo: DVec3,
+        set: ComponentSet,
+        pre: Option<&Inside>,
+        surface: Option<f64>,
+    ) -> Rgb {
+        if grazing(wi) || grazing(wo) || !wi.is_finite() || !wo.is_finite() {
+            return Rgb::ZERO;
+        }
+        let (e, x) = (side(wi), side(wo));
+        let reflect = e == x;
+        let (si, so) = match pre {
+            Some(g) => (g.si, g.so),
+            None => (wi.z.abs().min(1.0).sqrt(), wo.z.abs().min(1.0).sqrt()),
+        };
+        let mut out = Rgb::ZERO;
+        if reflect && set.contains(Component::Surface) {
+            let f = match surface {
+                Some(f) => f,
+                None => self.faces[e].reflection_with_sqrt(to_face_frame(wi, e), to_face_frame(wo, e), si, so),
+            };
+            out += Rgb::splat(f);
+        }
+        let (fe, fx) = (&self.faces[e], &self.faces[x]);
+        let mut sub = Rgb::ZERO;
+        if set.contains(Component::Multiple) {
+            if self.opts.energy_bound {
+                let (we, wx) = (lerp_rgb_sqrt(&self.w_tab[e], si), lerp_rgb_sqrt(&self.w_tab[x], so));
+                let c = if reflect { self.ms_r[e] } else { self.ms_t };
+                sub += c * we * wx;
+            } else {
+                let c = if reflect { self.c_r[e] } else { self.c_t[e] };
+                sub += c * (fe.att_with_sqrt(si) * fx.att_with_sqrt(so));
+            }
+        }
+        let att = fe.att_with_sqrt(si) * fx.att_with_sqrt(so);
+        if att <= 0.0 {
+            return out + sub * self.kappa;
+        }
+        let g = match pre {
+            Some(g) => *g,
+            None => self.inside(wi, wo, set.contains(Component::Single), (si, so)),
+        };
+        let (mu_i, mu_o) = (g.mu_i, g.mu_o);
+        if mu_i <= 0.0 || mu_o <= 0.0 {
+            return out + sub * self.kappa;
+        }
+        if set.contains(Component::Single) && self.lobe_sum > 0.0 && g.p_num > 0.0 {
+            let ka = att * g.p_num * fx.inv_n2();
+            if reflect && self.tau_min * (mu_i + mu_o) > TAU_DROP * mu_i * mu_o {
+                // tau (1/mu_i + 1/mu_o) > 40 in every channel: the
+                // exponential is below 4e-18 of 1; skip it (thick paper).
+                // One division for the phase function and the depth integral.
+                sub += self.albedo * (ka / (g.p_den * (mu_i + mu_o)));
+            } else if !reflect && self.tau_min > TAU_DROP * mu_i.max(mu_o) {
+                // Both paths through the sheet are attenuated by more
+                // than e^{-40}: dropped like the direct term below.
+            } else {
+                let k = ka / g.p_den;
+                let depth = |tau: f64| {
+                    if reflect {
+                        single::depth_reflection(tau, mu_i, mu_o)
+                    } else {
+                        single::depth_transmission(tau, mu_i, mu_o)
+                    }
+                };
+                if self.grey {
+                    sub += Rgb::splat(k * self.albedo.0[0] * depth(self.tau.0[0]));
+                } else {
+                    for c in 0..3 {
+                        sub.0[c] += k * self.albedo.0[c] * depth(self.tau.0[c]);
+                    }
+                }
+            }
+        }
+        if !reflect && set.contains(Component::Direct) && self.opts.direct && !self.kernel.is_delta() {
+            let mu_min = mu_i.min(mu_o);
+            // Dropped where e^{-tau/mu} < e^{-40} = 4e-18 of the unattenuated
+            // lobe: thick paper never pays for these exponentials.
+            let k = if self.tau_min > TAU_DROP * mu_min {
+                0.0
+            } else {
+                self.kernel.eval(DVec2::new(-wi.x, -wi.y), DVec2::new(wo.x, wo.y), 1.0)
+            };
+            if k > 0.0 {
+                let amp = fe.att_dir_with_sqrt(si) * fx.att_dir_with_sqrt(so) * k;
+                if self.grey {
+                    sub += Rgb::splat((-self.tau.0[0] / mu_min).exp() * amp);
+                } else {
+                    sub += self.tau.map(|t| (-t / mu_min).exp()) * amp;
+                }
+            }
+        }
+        out + sub * self.kappa
+    }
+
+    /// One component `f(wi, wo)` (no cosine; delta lobes excluded).
+    pub fn eval_component(&self, wi: DVec3, wo: DVec3, c: Component) -> Rgb {
+        self.eval_components(wi, wo, ComponentSet::only(c))
+    }
+
+    /// Weight of the delta direct lobe for incident `wi` and viewer `wo` on
+    /// opposite sides, both faces without microfacets: the transmittances,
+    /// the attenuation along the path inside, and the series of internal
+    /// reflections `1 / (1 - R_e R_x e^{-2 tau / mu})` (exact for smooth faces).
+    pub(super) fn direct_delta_weight(&self, wi: DVec3, wo: DVec3) -> Rgb {
+        let (e, x) = (side(wi), side(wo));
+        let (fe, fx) = (&self.faces[e], &self.faces[x]);
+        let (mi_out, mo_out) = (wi.z.abs(), wo.z.abs());
+        let mu = fe.inside_cos(mi_out);
+        if mu <= 0.0 {
+            return Rgb::ZERO;
+        }
+        let t = fe.att(mi_out) * fx.att(mo_out);
+        let r = if self.opts.use_att {
+            fe.r_in_delta(mu) * fx.r_in_delta(fx.inside_cos(mo_out))
+        } else {
+            0.0
+        };
+        self.tau.map(|tau| {
+            let a = (-tau / mu).exp();
+            t * a / (1.0 - r * a * a)
+        }) * self.kappa
+    }
+
+    /// Lobe selection probabilities for viewer `wo`: surface, single, multiple R,
+    /// multiple T, direct (normalised; all zero if nothing can be sampled).
+    ///
+    /// They depend on the face and `|wo.z|` only and are tabulated at
+    /// construction ([`PaperBsdf::lobe_probs_exact`] on [`NP`] nodes in
+    /// `sqrt(|wo.z|)`) and interpolated: a convex combination of probability
+    /// vectors, so they still sum to 1, and `sample` and `pdf` use the same
+    /// values, so the mixture density is exactly that of the sampler. (They are
+    /// only a choice of strategy weights: any positive values would be unbiased.)
+    #[inline(always)]
+    pub(super) fn lobe_probs(&self, wo: DVec3) -> [f64; 5] {
+        let st = wo.z.abs().min(1.0).sqrt();
+        let xs = st * (NP - 1) as f64;
+        let i = (xs as usize).min(NP - 2);
+        let f = xs - i as f64;
+        let tab = &self.pr_tab[side(wo)];
+        let (a, b) = (&tab[i], &tab[i + 1]);
+        std::array::from_fn(|k| a[k] * (1.0 - f) + b[k] * f)
+    }
+
+    /// Density of the single-scattering strategy: the phase function around
+    /// the inside viewer direction, refracted out through the face of `wi`.
+    #[inline]
+    pub(super) fn pdf_single(&self, wi: DVec3, g: &Inside) -> f64 {
+        if g.mu_i <= 0.0 || self.lobe_sum <= 0.0 {
+            return 0.0;
+        }
+        g.p_num * wi.z.abs() * self.faces[side(wi)].inv_n2() / (g.p_den * self.lobe_sum * g.mu_i)
+    }
+
+    /// The mixture density; `surface_pdf` is the face's reflection density if the caller has it.
+    pub(super) fn pdf_with(
+        &self,
+        wi: DVec3,
+        wo: DVec3,
+        pr: &[f64; 5],
+        pre: Option<&Inside>,
+        surface_pdf: Option<f64>,
+    ) -> f64 {
+        if grazing(wi) || grazing(wo) {
+            return 0.0;
+        }
+        let (e, x) = (side(wi), side(wo));
+        let mut pdf = 0.0;
+        if e == x {
+            if pr[0] > 0.0 {
+                pdf += pr[0]
+                    * match surface_pdf {
+                        Some(p) => p,
+                        None => self.faces[x].reflection_pdf(to_face_frame(wi, x), to_face_frame(wo, x)),
+                    };
+            }
+            pdf += pr[2] * wi.z.abs() / PI;
+        } else {
+            pdf += pr[3] * wi.z.abs() / PI;
+            if pr[4] > 0.0 && !self.kernel.is_delta() {
+                pdf += pr[4] * self.kernel.pdf_wi(wi, wo, 1.0);
+            }
+        }
+        if pr[1] > 0.0 {
+            let g = match pre {
+                Some(g) => *g,
+                // The table coordinates are not needed for densities.
+                None => self.inside(wi, wo, true, (0.0, 0.0)),
+            };
+            pdf += pr[1] * self.pdf_single(wi, &g);
+        }
+        pdf
+    }
+}
