@@ -68,7 +68,7 @@ fn main() {
                 report(
                     &what,
                     time(n / 4, |_| {
-                        black_box(black_box(&b).eval_component(black_box(wi), black_box(wo), c));
+                        black_box(black_box(&b).eval_components(black_box(wi), black_box(wo), c.into()));
                     }),
                 );
             }

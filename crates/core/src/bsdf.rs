@@ -109,6 +109,31 @@ pub trait Bsdf: Send + Sync {
     fn flags(&self) -> BsdfFlags;
 }
 
+/// Share of the total albedo estimate that [`defensive_probabilities`] adds
+/// to each present lobe's estimate.
+pub const LOBE_PROB_FLOOR: f64 = 0.02;
+
+/// Lobe-selection probabilities of a mixture sampler from albedo estimates
+/// `est` of its lobes: each `present` lobe gets `est + LOBE_PROB_FLOOR *
+/// total` (a defensive mixture: no lobe that carries light is sampled too
+/// rarely where the estimates are rough), normalised to sum to 1; all zero
+/// when nothing is present or the estimates are not finite. Any positive
+/// values are unbiased: they only weigh the strategies.
+pub fn defensive_probabilities<const N: usize>(est: [f64; N], present: [bool; N]) -> [f64; N] {
+    let total: f64 = est.iter().zip(&present).filter(|(_, p)| **p).map(|(e, _)| *e).sum();
+    let mut w = [0.0; N];
+    for k in 0..N {
+        if present[k] {
+            w[k] = est[k] + LOBE_PROB_FLOOR * total;
+        }
+    }
+    let sum: f64 = w.iter().sum();
+    if !sum.is_finite() || sum <= 0.0 {
+        return [0.0; N];
+    }
+    w.map(|v| v / sum)
+}
+
 /// Directional albedo seen from `wo`, split into reflection and transmission:
 /// `int f(wi, wo) |cos wi| dwi` over each hemisphere (pbrt-v4's `rho(wo)`),
 /// delta lobes included, by `n x n` stratified samples of [`Bsdf::sample`]

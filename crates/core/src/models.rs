@@ -2,7 +2,7 @@
 //! BSDF, the reduced multilayer model, the Lambertian + rough glass baseline
 //! and the rough dielectric alone, each a [`Bsdf`] whose components can be
 //! evaluated one by one ([`ComponentModel`]). Parameter files name them
-//! [`MODEL_NAMES`]: `paper` and `reduced-multilayer` take
+//! [`ModelKind`] (the one registry of model names): `paper` and `reduced-multilayer` take
 //! [`PaperParams`](crate::PaperParams), `lambert-glass` takes
 //! [`LambertGlassParams`], `rough-dielectric` takes [`RoughDielectricParams`].
 //!
@@ -41,14 +41,135 @@ use crate::microfacet::Distribution;
 use crate::paper::direct::SheetKernel;
 use crate::paper::face::{to_face_frame, Face};
 use crate::paper::grazing;
-pub use crate::paper::{Component, ComponentSet, PaperBsdf};
+pub use crate::paper::{Component, ComponentSet, PaperBsdf, Side};
 use crate::params::{Colour, ParamError};
 use crate::spectrum::Rgb;
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
 
-/// Names of the models in parameter files and on the command line.
-pub const MODEL_NAMES: [&str; 4] = ["paper", "reduced-multilayer", "lambert-glass", "rough-dielectric"];
+/// The models of the project, by the names that parameter files, FIT.json
+/// files, scenes and the command line use: the one registry of model names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ModelKind {
+    /// `paper`: the Paper BSDF ([`PaperBsdf::new`]), parameters [`PaperParams`](crate::PaperParams).
+    Paper,
+    /// `reduced-multilayer`: the supplement's reduced multilayer model
+    /// ([`PaperBsdf::reduced_multilayer`]), parameters [`PaperParams`](crate::PaperParams).
+    ReducedMultilayer,
+    /// `lambert-glass`: Lambertian + rough glass ([`LambertGlass`]), parameters [`LambertGlassParams`].
+    LambertGlass,
+    /// `rough-dielectric`: one rough interface ([`RoughDielectric`]), parameters [`RoughDielectricParams`].
+    RoughDielectric,
+    /// `measured`: a measured RGL `.bsdf` file; its "parameters" are the file
+    /// (read by `paperbsdf_io`, not by this crate).
+    Measured,
+}
+
+impl ModelKind {
+    /// Every model, in the order of the listings.
+    pub const ALL: [ModelKind; 5] = [
+        ModelKind::Paper,
+        ModelKind::ReducedMultilayer,
+        ModelKind::LambertGlass,
+        ModelKind::RoughDielectric,
+        ModelKind::Measured,
+    ];
+
+    /// The name in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Paper => "paper",
+            ModelKind::ReducedMultilayer => "reduced-multilayer",
+            ModelKind::LambertGlass => "lambert-glass",
+            ModelKind::RoughDielectric => "rough-dielectric",
+            ModelKind::Measured => "measured",
+        }
+    }
+
+    /// Whether the model is a slab whose parameters are [`PaperParams`](crate::PaperParams)
+    /// (`paper`, `reduced-multilayer`; the paper presets are such parameters).
+    pub fn is_slab(self) -> bool {
+        matches!(self, ModelKind::Paper | ModelKind::ReducedMultilayer)
+    }
+
+    /// Whether the fitter can fit the model (`paper`, `reduced-multilayer`, `lambert-glass`).
+    pub fn is_fittable(self) -> bool {
+        matches!(
+            self,
+            ModelKind::Paper | ModelKind::ReducedMultilayer | ModelKind::LambertGlass
+        )
+    }
+
+    /// The models the fitter can fit, in the order of the listings.
+    pub fn fittable() -> impl Iterator<Item = ModelKind> {
+        Self::ALL.into_iter().filter(|k| k.is_fittable())
+    }
+
+    /// The names of `kinds` joined by `, ` (for messages listing the allowed values).
+    pub fn list(kinds: impl IntoIterator<Item = ModelKind>) -> String {
+        kinds.into_iter().map(|k| k.name()).collect::<Vec<_>>().join(", ")
+    }
+
+    /// Builds the model from its typed parameters (`params` must be of this
+    /// model's parameter type; `measured` is built by `paperbsdf_io`). The
+    /// error names the parameter and its allowed range.
+    pub fn build(self, params: &ModelParams) -> Result<Box<dyn ComponentModel>, ParamError> {
+        match (self, params) {
+            (ModelKind::Paper, ModelParams::Slab(p)) => Ok(Box::new(PaperBsdf::new(p)?)),
+            (ModelKind::ReducedMultilayer, ModelParams::Slab(p)) => Ok(Box::new(PaperBsdf::reduced_multilayer(p)?)),
+            (ModelKind::LambertGlass, ModelParams::LambertGlass(p)) => Ok(Box::new(LambertGlass::new(p)?)),
+            (ModelKind::RoughDielectric, ModelParams::RoughDielectric(p)) => Ok(Box::new(p.build()?)),
+            (k, p) => Err(ParamError::Invalid {
+                name: "model".to_string(),
+                message: format!("model `{}` does not take {} parameters", k.name(), p.kind_name()),
+            }),
+        }
+    }
+}
+
+impl std::fmt::Display for ModelKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A model name that is not one of [`ModelKind::ALL`].
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown model `{}`; known models: {}", .0, ModelKind::list(ModelKind::ALL))]
+pub struct UnknownModel(pub String);
+
+impl std::str::FromStr for ModelKind {
+    type Err = UnknownModel;
+    /// Parses a name of [`ModelKind::name`] (exact, as in files).
+    fn from_str(s: &str) -> Result<Self, UnknownModel> {
+        ModelKind::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| UnknownModel(s.to_string()))
+    }
+}
+
+/// The typed parameters of a model of [`ModelKind`] (`paper` and
+/// `reduced-multilayer` share [`PaperParams`](crate::PaperParams)).
+#[derive(Clone, Debug, PartialEq)]
+pub enum ModelParams {
+    /// `paper`, `reduced-multilayer`.
+    Slab(crate::PaperParams),
+    /// `lambert-glass`.
+    LambertGlass(LambertGlassParams),
+    /// `rough-dielectric`.
+    RoughDielectric(RoughDielectricParams),
+}
+
+impl ModelParams {
+    fn kind_name(&self) -> &'static str {
+        match self {
+            ModelParams::Slab(_) => "paper-slab",
+            ModelParams::LambertGlass(_) => "lambert-glass",
+            ModelParams::RoughDielectric(_) => "rough-dielectric",
+        }
+    }
+}
 
 /// A [`Bsdf`] whose components can be evaluated separately (for plots and fits).
 pub trait ComponentModel: Bsdf {
@@ -62,7 +183,7 @@ pub trait ComponentModel: Bsdf {
 
 impl ComponentModel for PaperBsdf {
     fn eval_component(&self, wi: DVec3, wo: DVec3, c: Component) -> Rgb {
-        PaperBsdf::eval_component(self, wi, wo, c)
+        self.eval_components(wi, wo, c.into())
     }
     fn is_rgb(&self) -> bool {
         PaperBsdf::is_rgb(self)
@@ -176,7 +297,7 @@ impl LambertGlass {
         let mut out = Rgb::ZERO;
         if reflect {
             if set.contains(Component::Surface) {
-                let e = if wi.z > 0.0 { 0 } else { 1 };
+                let e = Side::of(wi);
                 out += Rgb::splat(self.face.reflection(to_face_frame(wi, e), to_face_frame(wo, e)));
             }
             if set.contains(Component::Multiple) {
@@ -209,18 +330,7 @@ impl LambertGlass {
             self.clear.mean() * self.face.att(mu) * self.face.att(mu),
         ];
         let present = [!self.face.is_index_matched(), est[1] > 0.0, est[2] > 0.0, est[3] > 0.0];
-        let total: f64 = est.iter().zip(&present).filter(|(_, p)| **p).map(|(e, _)| *e).sum();
-        let mut w = [0.0; 4];
-        for k in 0..4 {
-            if present[k] {
-                w[k] = est[k] + 0.02 * total;
-            }
-        }
-        let sum: f64 = w.iter().sum();
-        if sum.is_nan() || sum <= 0.0 {
-            return [0.0; 4];
-        }
-        w.map(|v| v / sum)
+        crate::bsdf::defensive_probabilities(est, present)
     }
 
     fn pdf_with(&self, wi: DVec3, wo: DVec3, pr: &[f64; 4]) -> f64 {
@@ -228,7 +338,7 @@ impl LambertGlass {
             return 0.0;
         }
         if wi.z * wo.z > 0.0 {
-            let e = if wo.z > 0.0 { 0 } else { 1 };
+            let e = Side::of(wo);
             pr[0] * self.face.reflection_pdf(to_face_frame(wi, e), to_face_frame(wo, e)) + pr[1] * wi.z.abs() / PI
         } else {
             let mut p = pr[2] * wi.z.abs() / PI;
@@ -260,7 +370,7 @@ impl Bsdf for LambertGlass {
             return None;
         }
         let so = wo.z.signum();
-        let x = if wo.z > 0.0 { 0 } else { 1 };
+        let x = Side::of(wo);
         let wi = match k {
             0 => {
                 if self.face.is_smooth() {
@@ -349,5 +459,46 @@ impl ComponentModel for LambertGlass {
     }
     fn components(&self) -> &'static [Component] {
         &[Component::Surface, Component::Multiple, Component::Direct]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every name parses back to its model, unknown names list all five, and
+    /// each model is built from its own parameter type only.
+    #[test]
+    fn registry_round_trips_and_builds() {
+        for k in ModelKind::ALL {
+            assert_eq!(k.name().parse::<ModelKind>(), Ok(k));
+        }
+        let e = "Paper".parse::<ModelKind>().unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "unknown model `Paper`; known models: paper, reduced-multilayer, lambert-glass, rough-dielectric, measured"
+        );
+        assert_eq!(
+            ModelKind::list(ModelKind::fittable()),
+            "paper, reduced-multilayer, lambert-glass"
+        );
+        let p = crate::presets::preset("matte").unwrap();
+        let slab = ModelParams::Slab(p.clone());
+        let m = ModelKind::Paper.build(&slab).unwrap();
+        let direct = PaperBsdf::new(&p).unwrap();
+        let (wi, wo) = (
+            DVec3::new(0.3, 0.1, 0.9).normalize(),
+            DVec3::new(-0.5, 0.2, 0.7).normalize(),
+        );
+        assert_eq!(m.eval(wi, wo), direct.eval(wi, wo));
+        assert_eq!(m.components(), &Component::ALL);
+        let r = ModelKind::ReducedMultilayer.build(&slab).unwrap();
+        assert_eq!(r.eval(wi, wo), PaperBsdf::reduced_multilayer(&p).unwrap().eval(wi, wo));
+        let e = ModelKind::LambertGlass.build(&slab).err().unwrap().to_string();
+        assert!(
+            e.contains("model `lambert-glass` does not take paper-slab parameters"),
+            "{e}"
+        );
+        assert!(ModelKind::Measured.build(&slab).is_err());
     }
 }

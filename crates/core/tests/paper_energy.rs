@@ -396,7 +396,10 @@ fn reciprocity_with_unequal_faces() {
                     let wi = DVec3::new(a.x, a.y, s1 * a.z);
                     let wo = DVec3::new(c.x, c.y, s2 * c.z);
                     for comp in Component::ALL {
-                        let (f1, f2) = (b.eval_component(wi, wo, comp), b.eval_component(wo, wi, comp));
+                        let (f1, f2) = (
+                            b.eval_components(wi, wo, comp.into()),
+                            b.eval_components(wo, wi, comp.into()),
+                        );
                         assert!(rel_close(f1, f2, 1e-9), "{comp} {wi:?} {wo:?}: {f1:?} vs {f2:?}\n{p:?}");
                     }
                     checked += 1;
@@ -556,7 +559,7 @@ proptest! {
             let f = b.eval(wi, wo);
             prop_assert!(f.is_finite() && f.0.iter().all(|&v| v >= 0.0), "eval {:?}", f);
             for c in Component::ALL {
-                let f = b.eval_component(wi, wo, c);
+                let f = b.eval_components(wi, wo, c.into());
                 prop_assert!(f.is_finite() && f.0.iter().all(|&v| v >= 0.0), "{} {:?}", c, f);
             }
             let pdf = b.pdf(wi, wo);

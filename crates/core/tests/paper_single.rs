@@ -15,7 +15,8 @@
 
 use paperbsdf_core::fresnel::fresnel_dielectric;
 use paperbsdf_core::geometry::spherical_direction;
-use paperbsdf_core::paper::{Component, PaperBsdf, PaperOptions};
+use paperbsdf_core::models::ComponentModel;
+use paperbsdf_core::paper::{Component, PaperBsdf, PaperOptions, Side};
 use paperbsdf_core::phase::{direction_at, sample_hg_cos};
 use paperbsdf_core::{Colour, DVec3, Distribution, PaperParams, Rgb};
 use rand::{Rng, SeedableRng};
@@ -222,7 +223,7 @@ fn reduced_multilayer_is_paper_with_att_one() {
         for (si, so) in [(1.0, 1.0), (1.0, -1.0), (-1.0, -1.0), (-1.0, 1.0)] {
             let wi = DVec3::new(wi.x, wi.y, si * wi.z);
             let wo = DVec3::new(wo.x, wo.y, so * wo.z);
-            let (e, x) = (if si > 0.0 { 0 } else { 1 }, if so > 0.0 { 0 } else { 1 });
+            let (e, x) = (Side::of(wi), Side::of(wo));
             let att = paper.att(e, wi.z.abs()) * paper.att(x, wo.z.abs());
             let (kp, kr) = (paper.subsurface_bound(), reduced.subsurface_bound());
             let s_p = paper.eval_component(wi, wo, Component::Single) / kp;
@@ -239,7 +240,7 @@ fn reduced_multilayer_is_paper_with_att_one() {
             );
             let (rd, _) = reduced.multipole_rd_td(e);
             // Transmission is the mean of both faces of entry (reciprocity).
-            let td = (reduced.multipole_rd_td(0).1 + reduced.multipole_rd_td(1).1) * 0.5;
+            let td = (reduced.multipole_rd_td(Side::Front).1 + reduced.multipole_rd_td(Side::Back).1) * 0.5;
             let flat = if e == x { rd } else { td } * (kr / PI);
             let m = reduced.eval_component(wi, wo, Component::Multiple);
             for c in 0..3 {
@@ -284,14 +285,15 @@ fn multiple_scattering_normalisation() {
     let wo = spherical_direction(0.9, 2.0);
     let wt = DVec3::new(wo.x, wo.y, -wo.z);
     let k = paper.subsurface_bound();
-    let (rd, td0) = paper.multipole_rd_td(0);
-    let td1 = paper.multipole_rd_td(1).1;
+    let (rd, td0) = paper.multipole_rd_td(Side::Front);
+    let td1 = paper.multipole_rd_td(Side::Back).1;
     let att = |f, w: DVec3| paper.att(f, w.z.abs());
     let mr = paper.eval_component(wi, wo, Component::Multiple);
     let mt = paper.eval_component(wi, wt, Component::Multiple);
     let n2 = p.eta_b * p.eta_b;
-    let er = rd * (k * att(0, wi) * att(0, wo) / (PI * n2 * (1.0 - rho_f)));
-    let et = (td0 / (1.0 - rho_b) + td1 / (1.0 - rho_f)) * (0.5 * k * att(0, wi) * att(1, wt) / (PI * n2));
+    let er = rd * (k * att(Side::Front, wi) * att(Side::Front, wo) / (PI * n2 * (1.0 - rho_f)));
+    let et = (td0 / (1.0 - rho_b) + td1 / (1.0 - rho_f))
+        * (0.5 * k * att(Side::Front, wi) * att(Side::Back, wt) / (PI * n2));
     for c in 0..3 {
         assert!((mr.0[c] - er.0[c]).abs() < 5e-3 * er.0[c], "R {mr:?} vs {er:?}");
         assert!((mt.0[c] - et.0[c]).abs() < 5e-3 * et.0[c], "T {mt:?} vs {et:?}");
@@ -317,9 +319,9 @@ fn single_scattering_albedo_table_matches_quadrature() {
     let mut worst: f64 = 0.0;
     for (k, p) in cases.iter().enumerate() {
         let b = PaperBsdf::new(p).unwrap();
-        for face in [0usize, 1] {
+        for face in Side::BOTH {
             for mu in [0.02f64, 0.17, 0.5, 0.93] {
-                let s = if face == 0 { 1.0 } else { -1.0 };
+                let s = face.sign();
                 let wi = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, s * mu);
                 let (r, t) = quad_albedo(&b, wi, Component::Single, 300);
                 let q = r + t;

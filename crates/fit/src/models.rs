@@ -28,12 +28,21 @@
 //! the box is a valid model.
 
 use crate::model::{Evaluable, FitModel, ParamSpec, Scale};
-use paperbsdf_core::models::{ComponentModel, LambertGlass, LambertGlassParams};
+use paperbsdf_core::models::{ComponentModel, LambertGlass, LambertGlassParams, ModelKind};
 use paperbsdf_core::paper::{Component, PaperBsdf};
 use paperbsdf_core::{Bsdf, Colour, DVec3, Distribution, FaceScattering, PaperParams, Rgb};
 
-/// Model names accepted by [`candidates`].
-pub const MODEL_NAMES: &[&str] = &["paper", "lambert-glass", "reduced-multilayer"];
+/// The model named `name` if the fitter can fit it; else the error lists the
+/// models it can fit.
+fn fittable(name: &str) -> Result<ModelKind, String> {
+    match name.parse::<ModelKind>() {
+        Ok(k) if k.is_fittable() => Ok(k),
+        _ => Err(format!(
+            "unknown model `{name}` for fitting; models that can be fitted: {}",
+            ModelKind::list(ModelKind::fittable())
+        )),
+    }
+}
 
 const DISTS: [Distribution; 2] = [Distribution::Ggx, Distribution::Beckmann];
 
@@ -161,9 +170,9 @@ pub fn build_paper(p: &PaperParams, reduced: bool) -> Result<PaperEval, String> 
 impl FitModel for PaperFit {
     fn model_name(&self) -> &str {
         if self.reduced {
-            "reduced-multilayer"
+            ModelKind::ReducedMultilayer.name()
         } else {
-            "paper"
+            ModelKind::Paper.name()
         }
     }
     fn variant(&self) -> String {
@@ -239,7 +248,7 @@ impl Evaluable for LambertGlassEval {
 
 impl FitModel for LambertGlassFit {
     fn model_name(&self) -> &str {
-        "lambert-glass"
+        ModelKind::LambertGlass.name()
     }
     fn variant(&self) -> String {
         format!("dist={}", self.dist.name())
@@ -280,8 +289,8 @@ pub fn candidates_with_faces(
     face_scattering: FaceScattering,
 ) -> Result<Vec<Box<dyn FitModel>>, String> {
     let ds: Vec<Distribution> = dists.map(|d| d.to_vec()).unwrap_or_else(|| DISTS.to_vec());
-    match name {
-        "paper" | "reduced-multilayer" => {
+    match fittable(name)? {
+        kind @ (ModelKind::Paper | ModelKind::ReducedMultilayer) => {
             let d = d.ok_or_else(|| {
                 format!("model `{name}` needs the paper's thickness d: pass --thickness D (mm) or give the data a `# thickness: D` or `# params: {{\"d\": D, ...}}` header")
             })?;
@@ -292,41 +301,36 @@ pub fn candidates_with_faces(
             for &f in &ds {
                 for &b in &ds {
                     v.push(Box::new(
-                        PaperFit::new(d, f, b, rgb, name == "reduced-multilayer").with_face_scattering(face_scattering),
+                        PaperFit::new(d, f, b, rgb, kind == ModelKind::ReducedMultilayer)
+                            .with_face_scattering(face_scattering),
                     ));
                 }
             }
             Ok(v)
         }
-        "lambert-glass" => Ok(ds
+        ModelKind::LambertGlass => Ok(ds
             .iter()
             .map(|&dd| Box::new(LambertGlassFit::new(dd, rgb)) as Box<dyn FitModel>)
             .collect()),
-        _ => Err(format!(
-            "unknown model `{name}`; known models: {}",
-            MODEL_NAMES.join(", ")
-        )),
+        k => unreachable!("fittable() returned {k}"),
     }
 }
 
 /// Builds model `name` from a parameter set (the `params` of a FIT.json).
 pub fn build_from_params(name: &str, params: &serde_json::Value) -> Result<Box<dyn Evaluable>, String> {
-    match name {
-        "paper" | "reduced-multilayer" => {
+    match fittable(name)? {
+        kind @ (ModelKind::Paper | ModelKind::ReducedMultilayer) => {
             let p: PaperParams =
                 serde_json::from_value(params.clone()).map_err(|e| format!("params of `{name}`: {e}"))?;
-            Ok(Box::new(build_paper(&p, name == "reduced-multilayer")?))
+            Ok(Box::new(build_paper(&p, kind == ModelKind::ReducedMultilayer)?))
         }
-        "lambert-glass" => {
+        ModelKind::LambertGlass => {
             let p: LambertGlassParams =
                 serde_json::from_value(params.clone()).map_err(|e| format!("params of `{name}`: {e}"))?;
             Ok(Box::new(LambertGlassEval(
                 LambertGlass::new(&p).map_err(|e| e.to_string())?,
             )))
         }
-        _ => Err(format!(
-            "unknown model `{name}`; known models: {}",
-            MODEL_NAMES.join(", ")
-        )),
+        k => unreachable!("fittable() returned {k}"),
     }
 }

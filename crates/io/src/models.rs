@@ -6,7 +6,7 @@
 
 use crate::params::{parse_text, read_source_full, Loaded};
 use crate::DataError;
-use paperbsdf_core::models::{ComponentModel, LambertGlass, LambertGlassParams, MODEL_NAMES};
+use paperbsdf_core::models::{ComponentModel, LambertGlass, LambertGlassParams, ModelKind, UnknownModel};
 use paperbsdf_core::paper::{Component, PaperBsdf};
 use paperbsdf_core::{Bsdf, DVec3, PaperParams, ParamError, Rgb, RoughDielectric, RoughDielectricParams};
 
@@ -27,17 +27,15 @@ pub enum LoadedModel {
 /// checked first, then that a FIT.json holds a fit of this model and that a
 /// preset is used with a slab model.
 pub fn load_model(name: &str, source: &str) -> Result<LoadedModel, DataError> {
-    if name == "measured" {
+    let kind: ModelKind = name.parse().map_err(|e: UnknownModel| DataError::Other {
+        file: "--model".to_string(),
+        message: e.to_string(),
+    })?;
+    if kind == ModelKind::Measured {
         return Ok(LoadedModel::Measured(Box::new(crate::MeasuredBsdf::load(source)?)));
     }
-    if !MODEL_NAMES.contains(&name) {
-        return Err(DataError::Other {
-            file: "--model".to_string(),
-            message: format!("unknown model `{name}`; known models: {}", MODEL_NAMES.join(", ")),
-        });
-    }
     let s = read_source_full(source)?;
-    let slab = matches!(name, "paper" | "reduced-multilayer");
+    let slab = kind.is_slab();
     if let Some(fit) = &s.fit_model {
         if fit != name {
             return Err(DataError::Other {
@@ -72,31 +70,32 @@ pub fn load_model_text(name: &str, text: &str, origin: &str, is_toml: bool) -> R
     fn build<T, U>(l: &Loaded<T>, f: impl FnOnce(&T) -> Result<U, ParamError>) -> Result<U, DataError> {
         f(&l.value).map_err(|e| l.param_error(e))
     }
-    Ok(match name {
-        "paper" => LoadedModel::Paper(Box::new(build(
+    let kind: ModelKind = name.parse().map_err(|e: UnknownModel| DataError::Other {
+        file: origin.to_string(),
+        message: e.to_string(),
+    })?;
+    Ok(match kind {
+        ModelKind::Paper => LoadedModel::Paper(Box::new(build(
             &loaded::<PaperParams>(text, origin, is_toml)?,
             PaperBsdf::new,
         )?)),
-        "reduced-multilayer" => LoadedModel::Paper(Box::new(build(
+        ModelKind::ReducedMultilayer => LoadedModel::Paper(Box::new(build(
             &loaded::<PaperParams>(text, origin, is_toml)?,
             PaperBsdf::reduced_multilayer,
         )?)),
-        "lambert-glass" => LoadedModel::LambertGlass(Box::new(build(
+        ModelKind::LambertGlass => LoadedModel::LambertGlass(Box::new(build(
             &loaded::<LambertGlassParams>(text, origin, is_toml)?,
             LambertGlass::new,
         )?)),
-        "rough-dielectric" => {
+        ModelKind::RoughDielectric => {
             LoadedModel::RoughDielectric(build(&loaded::<RoughDielectricParams>(text, origin, is_toml)?, |p| {
                 p.build()
             })?)
         }
-        _ => {
+        ModelKind::Measured => {
             return Err(DataError::Other {
                 file: origin.to_string(),
-                message: format!(
-                    "unknown model `{name}`; known models: {}, measured (an RGL .bsdf file)",
-                    MODEL_NAMES.join(", ")
-                ),
+                message: "the model `measured` is read from an RGL .bsdf file, not from parameter text".to_string(),
             })
         }
     })

@@ -31,7 +31,7 @@
 use crate::instrument::Y_WEIGHTS;
 use paperbsdf_core::models::ComponentModel;
 use paperbsdf_core::paper::multipole::Multipole;
-use paperbsdf_core::paper::{Component, PaperBsdf};
+use paperbsdf_core::paper::{Component, PaperBsdf, Side};
 use paperbsdf_core::quadrature::gauss_legendre_01;
 use paperbsdf_core::sheet::Sheet;
 use paperbsdf_core::{DVec3, PaperParams, Rgb};
@@ -232,8 +232,8 @@ fn tail(tab: &RadialTable, x: f64, nodes: &(Vec<f64>, Vec<f64>)) -> f64 {
 pub fn sheet_multipoles(paper: &PaperBsdf, p: &PaperParams) -> Option<[Multipole; 3]> {
     let sheet = Sheet::from_params(p).ok()?;
     let (rf, rb) = (
-        paper.face_inside_hemispherical(0).0,
-        paper.face_inside_hemispherical(1).0,
+        paper.face_inside_hemispherical(Side::Front).0,
+        paper.face_inside_hemispherical(Side::Back).0,
     );
     let sigma_s_p = sheet.sigma_s * (1.0 - sheet.phase.mean_cosine());
     let out: [Option<Multipole>; 3] =

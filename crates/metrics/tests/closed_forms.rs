@@ -273,7 +273,7 @@ fn edge_multipole_is_the_models() {
             };
             let b = PaperBsdf::new(&p).unwrap();
             let mps = sheet_multipoles(&b, &p).unwrap();
-            let (rd, td) = b.multipole_rd_td(0);
+            let (rd, td) = b.multipole_rd_td(paperbsdf_core::paper::Side::Front);
             for (c, mp) in mps.iter().enumerate() {
                 let (r, t) = mp.rd_td();
                 assert!(
@@ -283,7 +283,7 @@ fn edge_multipole_is_the_models() {
                     td.0[c]
                 );
             }
-            let rho_f = b.face_inside_hemispherical(0).0;
+            let rho_f = b.face_inside_hemispherical(paperbsdf_core::paper::Side::Front).0;
             match (fs, eta_f == 1.5) {
                 (FaceScattering::Single, true) => walter_rho = Some(rho_f),
                 (FaceScattering::Multiple, true) => {

@@ -362,7 +362,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .zip(&wos)
                 .enumerate()
                 .map(|(j, (&(t, o), &wo))| {
-                    let comp = |c| model.eval_component(wi, wo, c);
+                    let comp = |c| model.eval_components(wi, wo, paperbsdf_core::paper::ComponentSet::only(c));
                     Point {
                         transmission: t,
                         theta_o: o,

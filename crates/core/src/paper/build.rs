@@ -6,9 +6,11 @@
 //! normalisation, and the lobe-selection probabilities of the sampler; with
 //! the interpolation of the per-face tables in `sqrt(mu)`.
 
+use super::eval::{Lobe, LobeProbs};
 use super::face::{self, hemispherical_of_table, NA};
 use super::multipole::Multipole;
-use super::{side, single, PaperBsdf, TAU_DROP};
+use super::{side, single, PaperBsdf, PerSide, Side, NEGLIGIBLE, NODE_MU_MIN, TAU_DROP};
+use crate::bsdf::defensive_probabilities;
 use crate::quadrature::gauss_legendre_01;
 use crate::spectrum::Rgb;
 use glam::{DVec2, DVec3};
@@ -92,15 +94,14 @@ impl PaperBsdf {
     /// `W_e(mu) = a (Att_e(mu) - D_e(mu)) - Att_e(mu) E_ss,e(mu)` on the face
     /// nodes, its hemispherical integral `Wbar_e`, and the constants that split
     /// it between reflection and transmission reciprocally.
-    #[allow(clippy::needless_range_loop)] // faces and channels are indexed in pairs (e, 1 - e)
-    pub(super) fn build_ms_tables(&mut self, shares: &[(Rgb, Rgb); 2]) {
-        let mut wbar = [Rgb::ZERO; 2];
-        for e in 0..2 {
+    pub(super) fn build_ms_tables(&mut self, shares: &PerSide<(Rgb, Rgb)>) {
+        let mut wbar = PerSide([Rgb::ZERO; 2]);
+        for e in Side::BOTH {
             let mut d_nodes = [Rgb::ZERO; NS];
             if self.opts.direct && self.tau_min < TAU_DROP {
                 for (k, d) in d_nodes.iter_mut().enumerate() {
                     let t = k as f64 / (NS - 1) as f64;
-                    *d = self.direct_albedo(e, (t * t).max(1e-6));
+                    *d = self.direct_albedo(e, (t * t).max(NODE_MU_MIN));
                 }
             }
             let fe = &self.faces[e];
@@ -121,7 +122,7 @@ impl PaperBsdf {
             }
         }
         for c in 0..3 {
-            let pt = |e: usize, x: usize| {
+            let pt = |e: Side, x: Side| {
                 if wbar[x].0[c] > 0.0 {
                     shares[e].1 .0[c] / wbar[x].0[c]
                 } else {
@@ -130,18 +131,19 @@ impl PaperBsdf {
             };
             // The mean keeps the term reciprocal; the caps keep each face of
             // entry from sending through more than the multipole's total.
-            let tot = |e: usize| shares[e].0 .0[c] + shares[e].1 .0[c];
-            let cap = |e: usize, x: usize| {
+            let tot = |e: Side| shares[e].0 .0[c] + shares[e].1 .0[c];
+            let cap = |e: Side, x: Side| {
                 if wbar[x].0[c] > 0.0 {
                     tot(e) / wbar[x].0[c]
                 } else {
                     f64::INFINITY
                 }
             };
-            let q = (0.5 * (pt(0, 1) + pt(1, 0))).min(cap(0, 1)).min(cap(1, 0));
+            let (f, k) = (Side::Front, Side::Back);
+            let q = (0.5 * (pt(f, k) + pt(k, f))).min(cap(f, k)).min(cap(k, f));
             self.ms_t.0[c] = q / PI;
-            for e in 0..2 {
-                let x = 1 - e;
+            for e in Side::BOTH {
+                let x = e.other();
                 let t_share = q * wbar[x].0[c];
                 let r_share = (shares[e].0 .0[c] + shares[e].1 .0[c] - t_share).max(0.0);
                 self.ms_share[e].0 .0[c] = r_share;
@@ -162,12 +164,12 @@ impl PaperBsdf {
     /// constant for both faces keeps the model reciprocal.
     pub(super) fn multipole_bound(&self) -> f64 {
         let mut kappa: f64 = 1.0;
-        for e in 0..2 {
+        for e in Side::BOTH {
             let fe = &self.faces[e];
-            let x = 1 - e;
+            let x = e.other();
             for k in 0..NS {
                 let t = k as f64 / (NS - 1) as f64;
-                let mu = (t * t).max(1e-6);
+                let mu = (t * t).max(NODE_MU_MIN);
                 let att = fe.att_with_sqrt(t);
                 let ms = self.c_r[e] * (PI * fe.abar) + self.c_t[e] * (PI * self.faces[x].abar);
                 let d = if self.opts.direct && self.tau_min < TAU_DROP {
@@ -195,9 +197,9 @@ impl PaperBsdf {
     /// (spectrally accurate for a periodic integrand), beyond it the arc that
     /// lies inside the disk by Gauss-Legendre, so no point is wasted outside
     /// and no edge is cut by the rule. Accurate to about 1e-5 of the albedo.
-    pub(super) fn direct_albedo(&self, e: usize, mu: f64) -> Rgb {
-        let x = 1 - e;
-        let sign = if e == 0 { 1.0 } else { -1.0 };
+    pub(super) fn direct_albedo(&self, e: Side, mu: f64) -> Rgb {
+        let x = e.other();
+        let sign = e.sign();
         let wi = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, sign * mu);
         if self.kernel.is_delta() {
             let wo = DVec3::new(-wi.x, -wi.y, -wi.z);
@@ -298,14 +300,14 @@ impl PaperBsdf {
     pub(super) fn build_single_tables(&mut self, symmetric: bool) {
         static GL: std::sync::OnceLock<(Vec<f64>, Vec<f64>)> = std::sync::OnceLock::new();
         let (xq, wq) = GL.get_or_init(|| gauss_legendre_01(NQ));
-        for e in 0..2 {
-            if e == 1 && symmetric {
-                self.ess_tab[1] = self.ess_tab[0];
+        for e in Side::BOTH {
+            if e == Side::Back && symmetric {
+                self.ess_tab[Side::Back] = self.ess_tab[Side::Front];
                 continue;
             }
             let fe = &self.faces[e];
             let n = fe.n();
-            let sign_e = if e == 0 { 1.0 } else { -1.0 };
+            let sign_e = e.sign();
             for k in 0..NS {
                 let t = k as f64 / (NS - 1) as f64;
                 let mu = t * t;
@@ -315,12 +317,12 @@ impl PaperBsdf {
                 let t_i = DVec3::new(-sin_o / n, 0.0, -sign_e * mu_i).normalize();
                 let (sin_i, z_i) = (t_i.x.abs(), t_i.z);
                 let mut ess = Rgb::ZERO;
-                for xs in 0..2 {
+                for xs in Side::BOTH {
                     if xs != e && self.tau_min > TAU_DROP {
                         continue;
                     }
                     let fx = &self.faces[xs];
-                    let sign_x = if xs == 0 { 1.0 } else { -1.0 };
+                    let sign_x = xs.sign();
                     // Outside cosine (as v = sqrt(mu_out)) of the inside cosine mu_i: the lobes' peak.
                     let s_pk = sin_i * n;
                     let v_pk = if s_pk < 1.0 {
@@ -347,7 +349,7 @@ impl PaperBsdf {
                             // cos = sin_i s_in cos(phi) + z_i sign_x mu_t, phi over the full circle.
                             let zz = z_i * sign_x * mu_t;
                             let mut pphi = 0.0;
-                            for &(g, wl) in &self.lobes {
+                            for (g, wl) in self.phase.lobes() {
                                 if wl > 0.0 {
                                     pphi += wl * hg_azimuthal(g, zz, sin_i * s_in);
                                 }
@@ -384,60 +386,51 @@ impl PaperBsdf {
     }
 
     /// The lobe probabilities of [`PaperBsdf::lobe_probs`] computed from the
-    /// albedo estimates for viewer `wo` (the table's nodes).
-    pub(super) fn lobe_probs_exact(&self, wo: DVec3) -> [f64; 5] {
+    /// albedo estimates for viewer `wo` (the table's nodes): each present
+    /// lobe gets its estimate plus a floor ([`defensive_probabilities`]).
+    pub(super) fn lobe_probs_exact(&self, wo: DVec3) -> LobeProbs {
         let x = side(wo);
-        let ot = 1 - x;
+        let ot = x.other();
         let (fx, fo) = (&self.faces[x], &self.faces[ot]);
         let mu = wo.z.abs();
         let st = mu.min(1.0).sqrt();
         let att_o = fx.att_with_sqrt(st);
-        let mut est = [0.0; 5];
+        let mut est = LobeProbs([0.0; 5]);
         let mut present = [false; 5];
-        present[0] = !fx.is_index_matched();
-        est[0] = if fx.microfacet().is_some() {
+        est[Lobe::Surface] = if fx.microfacet().is_some() {
             fx.r_walter_with_sqrt(st)
         } else {
             fx.r_out_with_sqrt(st)
         };
-        est[1] = att_o * lerp_tab_sqrt(&self.ess_tab[x], st).mean() * self.kappa;
-        present[1] = self.lobe_sum > 0.0 && self.albedo.max_channel() > 0.0 && est[1] > 1e-12;
+        present[Lobe::Surface as usize] = !fx.is_index_matched();
+        est[Lobe::Single] = att_o * lerp_tab_sqrt(&self.ess_tab[x], st).mean() * self.kappa;
+        present[Lobe::Single as usize] =
+            self.phase.weight() > 0.0 && self.albedo.max_channel() > 0.0 && est[Lobe::Single] > NEGLIGIBLE;
         let lobes = fx.r_lobes_with_sqrt(st);
         if self.opts.energy_bound {
             let w = lerp_rgb_sqrt(&self.w_tab[x], st);
-            est[2] = (self.ms_share[x].0 * w).mean() + lobes;
-            est[3] = (self.ms_share[x].1 * w).mean();
+            est[Lobe::MultipleR] = (self.ms_share[x].0 * w).mean() + lobes;
+            est[Lobe::MultipleT] = (self.ms_share[x].1 * w).mean();
         } else {
-            est[2] = att_o * self.c_r[x].mean() * PI * fx.abar * self.kappa + lobes;
-            est[3] = att_o * self.c_t[x].mean() * PI * fo.abar * self.kappa;
+            est[Lobe::MultipleR] = att_o * self.c_r[x].mean() * PI * fx.abar * self.kappa + lobes;
+            est[Lobe::MultipleT] = att_o * self.c_t[x].mean() * PI * fo.abar * self.kappa;
         }
-        // Below 1e-12 of the incident flux a lobe is rounding noise (e.g. a
+        // Below NEGLIGIBLE of the incident flux a lobe is rounding noise (e.g. a
         // clear sheet's W = Att - D), not a strategy worth a share of samples.
-        present[2] = est[2] > 1e-12;
-        present[3] = est[3] > 1e-12;
+        present[Lobe::MultipleR as usize] = est[Lobe::MultipleR] > NEGLIGIBLE;
+        present[Lobe::MultipleT as usize] = est[Lobe::MultipleT] > NEGLIGIBLE;
         if self.opts.direct {
-            let mu_in = fx.inside_cos(mu).max(1e-6);
+            let mu_in = fx.inside_cos(mu).max(NODE_MU_MIN);
             let tm = self.tau.mean();
-            // Below e^{-40} the lobe is not present (threshold 1e-12 below).
-            est[4] = if tm > TAU_DROP * mu_in {
+            // Below e^{-TAU_DROP} the lobe is not present.
+            est[Lobe::Direct] = if tm > TAU_DROP * mu_in {
                 0.0
             } else {
                 fx.att_dir_with_sqrt(st) * fo.att_dir_with_sqrt(st) * (-tm / mu_in).exp()
             };
-            present[4] = est[4] > 1e-12;
+            present[Lobe::Direct as usize] = est[Lobe::Direct] > NEGLIGIBLE;
         }
-        let total: f64 = est.iter().zip(&present).filter(|(_, p)| **p).map(|(e, _)| *e).sum();
-        let mut w = [0.0; 5];
-        for k in 0..5 {
-            if present[k] {
-                w[k] = est[k] + 0.02 * total;
-            }
-        }
-        let sum: f64 = w.iter().sum();
-        if !sum.is_finite() || sum <= 0.0 {
-            return [0.0; 5];
-        }
-        w.map(|v| v / sum)
+        LobeProbs(defensive_probabilities(est.0, present))
     }
 }
 

@@ -24,19 +24,54 @@ pub(super) struct Inside {
     pub(super) p_den: f64,
 }
 
-impl PaperBsdf {
-    /// The mixture phase function (non-degenerate lobes) at cosine `cos`, as
-    /// `(numerator, denominator)` for callers that fold the division into
-    /// their own: `w HG(cos; g) = k / (q sqrt(q))`, `q = 1 + g^2 - 2 g cos`,
-    /// both lobes over one denominator (an absent lobe has `k = 0`, `q = 1`).
-    #[inline]
-    pub(super) fn phase_ratio(&self, cos: f64) -> (f64, f64) {
-        let [(k0, a0, b0), (k1, a1, b1)] = self.lobe_hg;
-        let (q0, q1) = (a0 - b0 * cos, a1 - b1 * cos);
-        let (d0, d1) = (q0 * q0.sqrt(), q1 * q1.sqrt());
-        (k0 * d1 + k1 * d0, d0 * d1)
-    }
+/// The sampling strategies of [`crate::Bsdf::sample`], one per lobe (module
+/// doc of [`super`]), in the order of [`LobeProbs`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Lobe {
+    /// The face's reflection (visible normals, or the delta of a smooth face).
+    Surface,
+    /// Single scattering: the phase function refracted through the macro normal.
+    Single,
+    /// Multiple scattering in reflection: a cosine lobe.
+    MultipleR,
+    /// Multiple scattering in transmission: a cosine lobe on the other side.
+    MultipleT,
+    /// Direct transmission: the kernel (or its delta).
+    Direct,
+}
 
+impl Lobe {
+    /// Every lobe, in the order of [`LobeProbs`].
+    pub(super) const ALL: [Lobe; 5] = [
+        Lobe::Surface,
+        Lobe::Single,
+        Lobe::MultipleR,
+        Lobe::MultipleT,
+        Lobe::Direct,
+    ];
+}
+
+/// A selection probability per [`Lobe`] (summing to 1, or all 0 when nothing
+/// can be sampled).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct LobeProbs(pub(super) [f64; 5]);
+
+impl std::ops::Index<Lobe> for LobeProbs {
+    type Output = f64;
+    #[inline(always)]
+    fn index(&self, l: Lobe) -> &f64 {
+        &self.0[l as usize]
+    }
+}
+
+impl std::ops::IndexMut<Lobe> for LobeProbs {
+    #[inline(always)]
+    fn index_mut(&mut self, l: Lobe) -> &mut f64 {
+        &mut self.0[l as usize]
+    }
+}
+
+impl PaperBsdf {
     /// Inside propagation directions `(t_i, t_o)` and cosines for outside `wi`, `wo`.
     #[inline(always)]
     pub(super) fn inside_dirs(&self, wi: DVec3, wo: DVec3) -> (DVec3, DVec3, f64, f64) {
@@ -53,8 +88,8 @@ impl PaperBsdf {
     #[inline(always)]
     pub(super) fn inside(&self, wi: DVec3, wo: DVec3, want_phase: bool, (si, so): (f64, f64)) -> Inside {
         let (t_i, t_o, mu_i, mu_o) = self.inside_dirs(wi, wo);
-        let (p_num, p_den) = if want_phase && self.lobe_sum > 0.0 {
-            self.phase_ratio(t_i.dot(t_o).clamp(-1.0, 1.0))
+        let (p_num, p_den) = if want_phase && self.phase.weight() > 0.0 {
+            self.phase.ratio(t_i.dot(t_o).clamp(-1.0, 1.0))
         } else {
             (0.0, 1.0)
         };
@@ -129,7 +164,7 @@ impl PaperBsdf {
         if mu_i <= 0.0 || mu_o <= 0.0 {
             return out + sub * self.kappa;
         }
-        if set.contains(Component::Single) && self.lobe_sum > 0.0 && g.p_num > 0.0 {
+        if set.contains(Component::Single) && self.phase.weight() > 0.0 && g.p_num > 0.0 {
             let ka = att * g.p_num * fx.inv_n2();
             if reflect && self.tau_min * (mu_i + mu_o) > TAU_DROP * mu_i * mu_o {
                 // tau (1/mu_i + 1/mu_o) > 40 in every channel: the
@@ -178,11 +213,6 @@ impl PaperBsdf {
         out + sub * self.kappa
     }
 
-    /// One component `f(wi, wo)` (no cosine; delta lobes excluded).
-    pub fn eval_component(&self, wi: DVec3, wo: DVec3, c: Component) -> Rgb {
-        self.eval_components(wi, wo, ComponentSet::only(c))
-    }
-
     /// Weight of the delta direct lobe for incident `wi` and viewer `wo` on
     /// opposite sides, both faces without microfacets: the transmittances,
     /// the attenuation along the path inside, and the series of internal
@@ -217,24 +247,24 @@ impl PaperBsdf {
     /// values, so the mixture density is exactly that of the sampler. (They are
     /// only a choice of strategy weights: any positive values would be unbiased.)
     #[inline(always)]
-    pub(super) fn lobe_probs(&self, wo: DVec3) -> [f64; 5] {
+    pub(super) fn lobe_probs(&self, wo: DVec3) -> LobeProbs {
         let st = wo.z.abs().min(1.0).sqrt();
         let xs = st * (NP - 1) as f64;
         let i = (xs as usize).min(NP - 2);
         let f = xs - i as f64;
         let tab = &self.pr_tab[side(wo)];
         let (a, b) = (&tab[i], &tab[i + 1]);
-        std::array::from_fn(|k| a[k] * (1.0 - f) + b[k] * f)
+        LobeProbs(std::array::from_fn(|k| a.0[k] * (1.0 - f) + b.0[k] * f))
     }
 
     /// Density of the single-scattering strategy: the phase function around
     /// the inside viewer direction, refracted out through the face of `wi`.
     #[inline]
     pub(super) fn pdf_single(&self, wi: DVec3, g: &Inside) -> f64 {
-        if g.mu_i <= 0.0 || self.lobe_sum <= 0.0 {
+        if g.mu_i <= 0.0 || self.phase.weight() <= 0.0 {
             return 0.0;
         }
-        g.p_num * wi.z.abs() * self.faces[side(wi)].inv_n2() / (g.p_den * self.lobe_sum * g.mu_i)
+        g.p_num * wi.z.abs() * self.faces[side(wi)].inv_n2() / (g.p_den * self.phase.weight() * g.mu_i)
     }
 
     /// The mixture density; `surface_pdf` is the face's reflection density if the caller has it.
@@ -242,7 +272,7 @@ impl PaperBsdf {
         &self,
         wi: DVec3,
         wo: DVec3,
-        pr: &[f64; 5],
+        pr: &LobeProbs,
         pre: Option<&Inside>,
         surface_pdf: Option<f64>,
     ) -> f64 {
@@ -252,27 +282,27 @@ impl PaperBsdf {
         let (e, x) = (side(wi), side(wo));
         let mut pdf = 0.0;
         if e == x {
-            if pr[0] > 0.0 {
-                pdf += pr[0]
+            if pr[Lobe::Surface] > 0.0 {
+                pdf += pr[Lobe::Surface]
                     * match surface_pdf {
                         Some(p) => p,
                         None => self.faces[x].reflection_pdf(to_face_frame(wi, x), to_face_frame(wo, x)),
                     };
             }
-            pdf += pr[2] * wi.z.abs() / PI;
+            pdf += pr[Lobe::MultipleR] * wi.z.abs() / PI;
         } else {
-            pdf += pr[3] * wi.z.abs() / PI;
-            if pr[4] > 0.0 && !self.kernel.is_delta() {
-                pdf += pr[4] * self.kernel.pdf_wi(wi, wo, 1.0);
+            pdf += pr[Lobe::MultipleT] * wi.z.abs() / PI;
+            if pr[Lobe::Direct] > 0.0 && !self.kernel.is_delta() {
+                pdf += pr[Lobe::Direct] * self.kernel.pdf_wi(wi, wo, 1.0);
             }
         }
-        if pr[1] > 0.0 {
+        if pr[Lobe::Single] > 0.0 {
             let g = match pre {
                 Some(g) => *g,
                 // The table coordinates are not needed for densities.
                 None => self.inside(wi, wo, true, (0.0, 0.0)),
             };
-            pdf += pr[1] * self.pdf_single(wi, &g);
+            pdf += pr[Lobe::Single] * self.pdf_single(wi, &g);
         }
         pdf
     }

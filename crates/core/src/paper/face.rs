@@ -35,6 +35,7 @@
 //! The back face (`z = -d`) is the same kind of object seen with `z` flipped:
 //! [`to_face_frame`] maps a direction on the back side to the face's frame.
 
+use super::Side;
 use crate::boundary::{critical_mu, SurfaceIntegrals};
 use crate::dielectric::{Interface, RoughDielectric};
 use crate::fresnel::fresnel_dielectric;
@@ -45,13 +46,12 @@ use crate::sheet::Sheet;
 use glam::DVec3;
 use std::f64::consts::PI;
 
-/// Mirrors `w` into the frame of the face on side `side` (0 front: identity; 1 back: `z -> -z`).
+/// Mirrors `w` into the frame of the face on `side` (front: identity; back: `z -> -z`).
 #[inline]
-pub(crate) fn to_face_frame(w: DVec3, side: usize) -> DVec3 {
-    if side == 0 {
-        w
-    } else {
-        DVec3::new(w.x, w.y, -w.z)
+pub(crate) fn to_face_frame(w: DVec3, side: Side) -> DVec3 {
+    match side {
+        Side::Front => w,
+        Side::Back => DVec3::new(w.x, w.y, -w.z),
     }
 }
 

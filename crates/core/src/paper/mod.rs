@@ -81,10 +81,12 @@ mod sample;
 pub mod single;
 
 use crate::params::{PaperParams, ParamError};
+use crate::phase::HgLobes;
 use crate::sheet::Sheet;
 use crate::spectrum::Rgb;
 use build::{lerp_tab, multipole_shares, NP, NS};
 use direct::SheetKernel;
+use eval::LobeProbs;
 use face::{Face, NA};
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -125,46 +127,117 @@ pub(crate) fn grazing(w: DVec3) -> bool {
     w.z.abs() < GRAZING_COS
 }
 
-#[inline]
-fn side(w: DVec3) -> usize {
-    if w.z > 0.0 {
-        0
-    } else {
-        1
+/// A side of the sheet: the front face (`z = 0`, outside normal `+z`) or the
+/// back face (`z = -d`, outside normal `-z`). Light arrives at, and leaves
+/// through, one of them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Side {
+    /// The front face, `z = 0`: directions with `z > 0` are outside it.
+    Front,
+    /// The back face, `z = -d`: directions with `z < 0` are outside it.
+    Back,
+}
+
+impl Side {
+    /// Both sides, front first.
+    pub const BOTH: [Side; 2] = [Side::Front, Side::Back];
+
+    /// The side that outside direction `w` (pointing away from the sheet) is
+    /// on: the front for `w.z > 0`, else the back.
+    #[inline]
+    pub fn of(w: DVec3) -> Side {
+        if w.z > 0.0 {
+            Side::Front
+        } else {
+            Side::Back
+        }
     }
+    /// The opposite side.
+    #[inline]
+    pub fn other(self) -> Side {
+        match self {
+            Side::Front => Side::Back,
+            Side::Back => Side::Front,
+        }
+    }
+    /// The sign of `z` of the directions outside this side: `+1` front, `-1` back.
+    #[inline]
+    pub fn sign(self) -> f64 {
+        match self {
+            Side::Front => 1.0,
+            Side::Back => -1.0,
+        }
+    }
+    /// Name in messages and files (`front`, `back`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Side::Front => "front",
+            Side::Back => "back",
+        }
+    }
+}
+
+impl std::fmt::Display for Side {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// One value per side of the sheet, indexed by [`Side`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PerSide<T>(pub [T; 2]);
+
+impl<T> std::ops::Index<Side> for PerSide<T> {
+    type Output = T;
+    #[inline(always)]
+    fn index(&self, s: Side) -> &T {
+        &self.0[s as usize]
+    }
+}
+
+impl<T> std::ops::IndexMut<Side> for PerSide<T> {
+    #[inline(always)]
+    fn index_mut(&mut self, s: Side) -> &mut T {
+        &mut self.0[s as usize]
+    }
+}
+
+/// The side of outside direction `w` ([`Side::of`]).
+#[inline(always)]
+fn side(w: DVec3) -> Side {
+    Side::of(w)
 }
 
 /// The Paper BSDF (module doc). Build with [`PaperBsdf::new`] or [`PaperBsdf::reduced_multilayer`].
 #[derive(Clone, Debug)]
 pub struct PaperBsdf {
-    faces: [Face; 2],
-    /// HG lobes `(g, weight)` without their delta parts ([`delta_fraction`],
-    /// [`PaperBsdf::new`]), weights relative to the scattering that changes directions.
-    lobes: [(f64, f64); 2],
-    /// Per lobe `(w (1 - g^2) / (4 pi), 1 + g^2, 2 g)`: [`PaperBsdf::phase_ratio`]'s constants.
-    lobe_hg: [(f64, f64, f64); 2],
-    lobe_sum: f64,
+    faces: PerSide<Face>,
+    /// The phase function's HG lobes without their delta parts
+    /// ([`delta_fraction`], [`PaperBsdf::new`]), backward lobe first, weights
+    /// relative to the scattering that changes directions.
+    phase: HgLobes,
     /// Single-scattering albedo `sigma_s / sigma_t` of the scattering that changes directions.
     albedo: Rgb,
     /// Optical thickness of the scattering that changes directions and of absorption.
     tau: Rgb,
     /// Per face of entry: `W_e(mu)`, the flux per unit incident flux that
     /// reaches the diffusion (module doc), on the [`NA`] nodes of the face tables.
-    w_tab: [[Rgb; NA]; 2],
+    w_tab: PerSide<[Rgb; NA]>,
     /// Per face of entry: `P_R'(e) / (pi Wbar_e)`, the multiple-scattering reflection constant.
-    ms_r: [Rgb; 2],
+    ms_r: PerSide<Rgb>,
     /// `Q / pi`: the multiple-scattering transmission constant (the same both ways).
     ms_t: Rgb,
     /// Per face of entry: the share `P_R'(e)` and `Q Wbar_x` of the flux `W_e` that leaves by reflection and transmission.
-    ms_share: [(Rgb, Rgb); 2],
+    ms_share: PerSide<(Rgb, Rgb)>,
     /// The flat constants of the multipole normalisation (`energy_bound` off).
-    c_r: [Rgb; 2],
-    c_t: [Rgb; 2],
+    c_r: PerSide<Rgb>,
+    c_t: PerSide<Rgb>,
     /// The bound of the multipole normalisation: every subsurface term is scaled by it (1 otherwise).
     kappa: f64,
-    ess_tab: [[Rgb; NS]; 2],
+    /// Per face of entry: the single-scattering albedo `E_ss` on [`NS`] nodes in `sqrt(mu)`.
+    ess_tab: PerSide<[Rgb; NS]>,
     /// Per face of exit and node of [`NP`]: the lobe probabilities of [`PaperBsdf::lobe_probs`].
-    pr_tab: [[[f64; 5]; NP]; 2],
+    pr_tab: PerSide<[LobeProbs; NP]>,
     kernel: SheetKernel,
     opts: PaperOptions,
     is_rgb: bool,
@@ -172,13 +245,22 @@ pub struct PaperBsdf {
     grey: bool,
     /// Smallest channel of `tau`.
     tau_min: f64,
-    rd_td: [(Rgb, Rgb); 2],
+    /// Per face of entry: the multipole's `(R_d, T_d)`.
+    rd_td: PerSide<(Rgb, Rgb)>,
 }
 
 /// Optical thickness above which light crossing the sheet unscattered (on
 /// either leg of a path) is below `e^{-40} = 4e-18` of the unattenuated
 /// value: transmission terms are not worth their exponentials.
 const TAU_DROP: f64 = 40.0;
+
+/// Outside cosine of the tables' node at grazing (`t = 0`): just above the
+/// sheet's plane, where the face integrals are still defined.
+const NODE_MU_MIN: f64 = 1e-6;
+
+/// Fraction of the incident flux below which a lobe counts as absent for
+/// sampling (rounding noise, not a strategy worth a share of samples).
+const NEGLIGIBLE: f64 = 1e-12;
 
 /// `|g|` above which part of a Henyey-Greenstein lobe is taken as a delta.
 pub const G_DELTA_FROM: f64 = 0.9;
@@ -228,7 +310,6 @@ impl PaperBsdf {
     }
 
     /// The model of `p` with explicit options.
-    #[allow(clippy::needless_range_loop)] // faces are indexed in pairs (e, 1 - e)
     pub fn with_options(p: &PaperParams, opts: PaperOptions) -> Result<PaperBsdf, ParamError> {
         let sheet = Sheet::from_params(p)?;
         // Two identical faces (the usual uncoated paper): build one, and the
@@ -240,7 +321,7 @@ impl PaperBsdf {
         } else {
             Face::of_sheet(&sheet, true, opts.use_att)
         };
-        let faces = [face_f, face_b];
+        let faces = PerSide([face_f, face_b]);
         // Near-delta lobes (module doc): the delta part of a forward lobe is
         // no scattering at all; that of a backward lobe joins the diffusion.
         let mut w_straight = 0.0;
@@ -264,37 +345,34 @@ impl PaperBsdf {
                 l.1 /= 1.0 - w_straight;
             }
         }
-        let lobe_sum = lobes[0].1 + lobes[1].1;
-        let lobe_hg = lobes.map(|(g, w)| (w * (1.0 - g * g) / (4.0 * PI), 1.0 + g * g, 2.0 * g));
+        let phase = HgLobes::new(lobes);
         let sigma_s_p = sheet.sigma_s * (1.0 - sheet.phase.mean_cosine());
         let kernel = SheetKernel::new([
             (
                 p.eta_f,
-                faces[0].microfacet().map_or(0.0, |_| p.m_f),
+                faces[Side::Front].microfacet().map_or(0.0, |_| p.m_f),
                 p.dist_f == crate::Distribution::Beckmann,
             ),
             (
                 p.eta_b,
-                faces[1].microfacet().map_or(0.0, |_| p.m_b),
+                faces[Side::Back].microfacet().map_or(0.0, |_| p.m_b),
                 p.dist_b == crate::Distribution::Beckmann,
             ),
         ]);
         let mut me = PaperBsdf {
             faces,
-            lobes,
-            lobe_hg,
-            lobe_sum,
+            phase,
             albedo,
             tau,
-            w_tab: [[Rgb::ZERO; NA]; 2],
-            ms_r: [Rgb::ZERO; 2],
+            w_tab: PerSide([[Rgb::ZERO; NA]; 2]),
+            ms_r: PerSide([Rgb::ZERO; 2]),
             ms_t: Rgb::ZERO,
-            ms_share: [(Rgb::ZERO, Rgb::ZERO); 2],
-            c_r: [Rgb::ZERO; 2],
-            c_t: [Rgb::ZERO; 2],
+            ms_share: PerSide([(Rgb::ZERO, Rgb::ZERO); 2]),
+            c_r: PerSide([Rgb::ZERO; 2]),
+            c_t: PerSide([Rgb::ZERO; 2]),
             kappa: 1.0,
-            ess_tab: [[Rgb::ZERO; NS]; 2],
-            pr_tab: [[[0.0; 5]; NP]; 2],
+            ess_tab: PerSide([[Rgb::ZERO; NS]; 2]),
+            pr_tab: PerSide([[LobeProbs([0.0; 5]); NP]; 2]),
             kernel,
             opts,
             is_rgb: p.is_rgb(),
@@ -302,7 +380,7 @@ impl PaperBsdf {
                 && tau.0[1] == tau.0[2]
                 && albedo.0[0] == albedo.0[1]
                 && albedo.0[1] == albedo.0[2],
-            rd_td: [(Rgb::ZERO, Rgb::ZERO); 2],
+            rd_td: PerSide([(Rgb::ZERO, Rgb::ZERO); 2]),
             tau_min: tau.0[0].min(tau.0[1]).min(tau.0[2]),
         };
         me.build_single_tables(symmetric);
@@ -317,9 +395,9 @@ impl PaperBsdf {
                 0.0
             }
         };
-        let mut shares = [(Rgb::ZERO, Rgb::ZERO); 2];
-        for e in 0..2 {
-            let x = 1 - e;
+        let mut shares = PerSide([(Rgb::ZERO, Rgb::ZERO); 2]);
+        for e in Side::BOTH {
+            let x = e.other();
             let (fe, fx) = (&me.faces[e], &me.faces[x]);
             let (mut pr, mut pt, mut rd, mut td) = (Rgb::ZERO, Rgb::ZERO, Rgb::ZERO, Rgb::ZERO);
             for c in 0..3 {
@@ -338,19 +416,19 @@ impl PaperBsdf {
             me.c_t[e] = td * esc(fx) / norm(fx);
         }
         // Symmetric multipole-normalisation transmission (reciprocity).
-        let ct = (me.c_t[0] + me.c_t[1]) * 0.5;
-        me.c_t = [ct; 2];
+        let ct = (me.c_t[Side::Front] + me.c_t[Side::Back]) * 0.5;
+        me.c_t = PerSide([ct; 2]);
         if opts.energy_bound {
             me.build_ms_tables(&shares);
         } else {
             me.kappa = me.multipole_bound();
         }
-        for x in 0..2 {
-            let sign = if x == 0 { 1.0 } else { -1.0 };
+        for x in Side::BOTH {
+            let sign = x.sign();
             for k in 0..NP {
                 let t = k as f64 / (NP - 1) as f64;
                 // The node at grazing is taken just above the sheet's plane.
-                let mu = (t * t).max(1e-6);
+                let mu = (t * t).max(NODE_MU_MIN);
                 let wo = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, sign * mu);
                 me.pr_tab[x][k] = me.lobe_probs_exact(wo);
             }
@@ -368,10 +446,9 @@ impl PaperBsdf {
         self.opts
     }
 
-    /// `(R_d, T_d)` of the multipole for light entering through the front
-    /// (`face = 0`) or back (`face = 1`) face, before any normalisation.
-    pub fn multipole_rd_td(&self, face: usize) -> (Rgb, Rgb) {
-        self.rd_td[face.min(1)]
+    /// `(R_d, T_d)` of the multipole for light entering through `face`, before any normalisation.
+    pub fn multipole_rd_td(&self, face: Side) -> (Rgb, Rgb) {
+        self.rd_td[face]
     }
 
     /// The constant `kappa <= 1` by which the multipole normalisation's
@@ -381,33 +458,32 @@ impl PaperBsdf {
         self.kappa
     }
 
-    /// `Att` of the front (`face = 0`) or back face at outside cosine `mu`.
-    pub fn att(&self, face: usize, mu: f64) -> f64 {
-        self.faces[face.min(1)].att(mu)
+    /// `Att` of `face` at outside cosine `mu`.
+    pub fn att(&self, face: Side, mu: f64) -> f64 {
+        self.faces[face].att(mu)
     }
 
-    /// `(rho_in, Tbar_in)` of the front (`face = 0`) or back face for diffuse light from inside.
-    pub fn face_inside_hemispherical(&self, face: usize) -> (f64, f64) {
-        let f = &self.faces[face.min(1)];
+    /// `(rho_in, Tbar_in)` of `face` for diffuse light from inside.
+    pub fn face_inside_hemispherical(&self, face: Side) -> (f64, f64) {
+        let f = &self.faces[face];
         (f.rho_in(), f.tbar_in())
     }
 
-    /// `(k_o, k_i)` of the energy compensation of the front (`face = 0`) or
-    /// back face: the transmitted shares of the energy Walter's interface loses
+    /// `(k_o, k_i)` of the energy compensation of `face`: the transmitted shares of the energy Walter's interface loses
     /// for light from outside and from inside ([`face`]; 0 for Walter's faces).
-    pub fn face_compensation(&self, face: usize) -> (f64, f64) {
-        self.faces[face.min(1)].compensation_shares()
+    pub fn face_compensation(&self, face: Side) -> (f64, f64) {
+        self.faces[face].compensation_shares()
     }
 
-    /// Directional reflectance of the front (`face = 0`) or back face alone
+    /// Directional reflectance of `face` alone
     /// for light from outside at cosine `mu` (every lobe of the face).
-    pub fn face_reflectance(&self, face: usize, mu: f64) -> f64 {
-        self.faces[face.min(1)].r_out(mu)
+    pub fn face_reflectance(&self, face: Side, mu: f64) -> f64 {
+        self.faces[face].r_out(mu)
     }
 
     /// Albedo of the single-scattering term (reflection plus transmission) per
     /// unit flux *entering* through `face` at outside cosine `mu` (tabulated).
-    pub fn single_scattering_albedo(&self, face: usize, mu: f64) -> Rgb {
-        lerp_tab(&self.ess_tab[face.min(1)], mu)
+    pub fn single_scattering_albedo(&self, face: Side, mu: f64) -> Rgb {
+        lerp_tab(&self.ess_tab[face], mu)
     }
 }

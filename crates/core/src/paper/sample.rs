@@ -2,11 +2,11 @@
 //! and `sample`, which picks a lobe by the tabulated probabilities and
 //! samples it (module doc of [`super`]).
 
+use super::eval::Lobe;
 use super::face::to_face_frame;
-use super::{grazing, side, ComponentSet, PaperBsdf};
+use super::{grazing, side, ComponentSet, PaperBsdf, Side};
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample};
 use crate::geometry::sample_cosine_hemisphere;
-use crate::phase::{direction_at, sample_hg_cos};
 use crate::spectrum::Rgb;
 use glam::{DVec2, DVec3};
 
@@ -20,19 +20,21 @@ impl Bsdf for PaperBsdf {
             return None;
         }
         let pr = self.lobe_probs(wo);
+        // The lobe whose interval of the cumulative probabilities holds `uc`.
         let mut k = 0;
         let mut acc = 0.0;
-        while k < 4 && uc >= acc + pr[k] {
-            acc += pr[k];
+        while k < 4 && uc >= acc + pr.0[k] {
+            acc += pr.0[k];
             k += 1;
         }
-        if pr[k] <= 0.0 {
+        let lobe = Lobe::ALL[k];
+        if pr[lobe] <= 0.0 {
             return None;
         }
         let x = side(wo);
-        let sx = if x == 0 { 1.0 } else { -1.0 };
-        let wi = match k {
-            0 => {
+        let sx = x.sign();
+        let wi = match lobe {
+            Lobe::Surface => {
                 let fx = &self.faces[x];
                 if fx.microfacet().is_none() {
                     let wi = DVec3::new(-wo.x, -wo.y, wo.z);
@@ -40,30 +42,25 @@ impl Bsdf for PaperBsdf {
                     return Some(BsdfSample {
                         wi,
                         f: Rgb::splat(f / wi.z.abs()),
-                        pdf: pr[0],
+                        pdf: pr[Lobe::Surface],
                         flags: BsdfFlags::REFLECTION | BsdfFlags::SPECULAR,
                     });
                 }
                 to_face_frame(fx.sample_reflection(to_face_frame(wo, x), u)?, x)
             }
-            1 => {
+            Lobe::Single => {
                 let fx = &self.faces[x];
                 let mu_o = fx.inside_cos(wo.z.abs());
                 // A unit vector: |t_o|^2 = (1 - wo.z^2) / n^2 + mu_o^2 = 1 (Snell).
                 let t_o = DVec3::new(wo.x * fx.inv_n(), wo.y * fx.inv_n(), sx * mu_o);
                 // Reuse the lobe-choice number to pick the HG lobe.
-                let ucr = ((uc - acc) / pr[k]).clamp(0.0, 1.0 - 1e-16);
-                let g = if ucr * self.lobe_sum < self.lobes[0].1 {
-                    self.lobes[0].0
-                } else {
-                    self.lobes[1].0
-                };
-                let t_i = direction_at(t_o, sample_hg_cos(g, u[0]), u[1]);
+                let ucr = ((uc - acc) / pr[lobe]).clamp(0.0, 1.0 - 1e-16);
+                let t_i = self.phase.sample(t_o, ucr, u);
                 if t_i.z == 0.0 {
                     return None;
                 }
                 // Light propagating down (t_i.z < 0) came in through the front face.
-                let e = if t_i.z < 0.0 { 0 } else { 1 };
+                let e = if t_i.z < 0.0 { Side::Front } else { Side::Back };
                 let n = self.faces[e].n();
                 let wt = DVec2::new(-t_i.x * n, -t_i.y * n);
                 let r2 = wt.length_squared();
@@ -71,14 +68,14 @@ impl Bsdf for PaperBsdf {
                     return None;
                 }
                 let z = (1.0 - r2).sqrt();
-                DVec3::new(wt.x, wt.y, if e == 0 { z } else { -z })
+                DVec3::new(wt.x, wt.y, e.sign() * z)
             }
-            2 | 3 => {
+            Lobe::MultipleR | Lobe::MultipleT => {
                 let w = sample_cosine_hemisphere(u);
-                let s = if k == 2 { sx } else { -sx };
+                let s = if lobe == Lobe::MultipleR { sx } else { -sx };
                 DVec3::new(w.x, w.y, s * w.z)
             }
-            _ => {
+            Lobe::Direct => {
                 let se = -sx;
                 if self.kernel.is_delta() {
                     let wi = DVec3::new(-wo.x, -wo.y, se * wo.z.abs());
@@ -86,7 +83,7 @@ impl Bsdf for PaperBsdf {
                     return Some(BsdfSample {
                         wi,
                         f: wgt / wi.z.abs(),
-                        pdf: pr[4],
+                        pdf: pr[Lobe::Direct],
                         flags: BsdfFlags::TRANSMISSION | BsdfFlags::SPECULAR,
                     });
                 }
@@ -109,9 +106,9 @@ impl Bsdf for PaperBsdf {
             return None;
         }
         let reflect = wi.z * wo.z > 0.0;
-        let lobe = match k {
-            0 | 4 => BsdfFlags::GLOSSY,
-            _ => BsdfFlags::DIFFUSE,
+        let kind = match lobe {
+            Lobe::Surface | Lobe::Direct => BsdfFlags::GLOSSY,
+            Lobe::Single | Lobe::MultipleR | Lobe::MultipleT => BsdfFlags::DIFFUSE,
         };
         let dir = if reflect {
             BsdfFlags::REFLECTION
@@ -122,7 +119,7 @@ impl Bsdf for PaperBsdf {
             wi,
             f: self.eval_with(wi, wo, ComponentSet::ALL, Some(&geo), surf_f),
             pdf,
-            flags: dir | lobe,
+            flags: dir | kind,
         })
     }
 
@@ -136,10 +133,10 @@ impl Bsdf for PaperBsdf {
 
     fn flags(&self) -> BsdfFlags {
         let mut f = BsdfFlags::REFLECTION | BsdfFlags::TRANSMISSION | BsdfFlags::DIFFUSE;
-        if self.faces.iter().any(|f| f.microfacet().is_some()) || (self.opts.direct && !self.kernel.is_delta()) {
+        if self.faces.0.iter().any(|f| f.microfacet().is_some()) || (self.opts.direct && !self.kernel.is_delta()) {
             f |= BsdfFlags::GLOSSY;
         }
-        if self.faces.iter().any(|f| f.is_smooth()) || (self.opts.direct && self.kernel.is_delta()) {
+        if self.faces.0.iter().any(|f| f.is_smooth()) || (self.opts.direct && self.kernel.is_delta()) {
             f |= BsdfFlags::SPECULAR;
         }
         f
