@@ -7,20 +7,14 @@
 //! the interpolation of the per-face tables in `sqrt(mu)`.
 
 use super::eval::{Lobe, LobeProbs};
-use super::face::{self, hemispherical_of_table, NA};
 use super::multipole::Multipole;
+use super::tables::{hemispherical_of_table, lerp_nodes, NA, NS};
 use super::{side, single, PaperBsdf, PerSide, Side, NEGLIGIBLE, NODE_MU_MIN, TAU_DROP};
 use crate::bsdf::defensive_probabilities;
 use crate::quadrature::gauss_legendre_01;
 use crate::spectrum::Rgb;
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
-
-/// Nodes of the lobe-probability table in the outside cosine (`mu = t^2`, `t` uniform).
-pub(super) const NP: usize = 33;
-
-/// Number of nodes of the per-face tables in the outside cosine (`mu = t^2`, `t` uniform).
-pub(super) const NS: usize = 33;
 
 /// Gauss-Legendre points per part of the single-scattering albedo quadrature
 /// in the exit cosine ([`PaperBsdf::build_tables`]).
@@ -49,27 +43,6 @@ pub(super) fn hg_azimuthal(g: f64, z: f64, r: f64) -> f64 {
     let pb = m1 * (0.249_983_683_10 + m1 * (0.092_001_800_37 + m1 * (0.040_696_975_26 + m1 * 0.005_264_496_39)));
     let ell_e = if m1 > 0.0 { pa - pb * m1.ln() } else { 1.0 };
     (1.0 - g * g) / (4.0 * PI) * 4.0 * ell_e / (amb * apb.sqrt())
-}
-
-#[inline]
-pub(super) fn lerp_tab(tab: &[Rgb; NS], mu: f64) -> Rgb {
-    lerp_tab_sqrt(tab, mu.abs().min(1.0).sqrt())
-}
-
-/// [`lerp_tab`] given `st = sqrt(min(|mu|, 1))`.
-#[inline(always)]
-pub(super) fn lerp_tab_sqrt(tab: &[Rgb; NS], st: f64) -> Rgb {
-    let x = st * (NS - 1) as f64;
-    let i = (x as usize).min(NS - 2);
-    let f = x - i as f64;
-    tab[i] * (1.0 - f) + tab[i + 1] * f
-}
-
-/// [`lerp_sqrt`] of an RGB table on the face nodes, channel by channel.
-#[inline(always)]
-pub(super) fn lerp_rgb_sqrt(tab: &[Rgb; NA], st: f64) -> Rgb {
-    let (i, f) = face::node_at(st);
-    tab[i] * (1.0 - f) + tab[i + 1] * f
 }
 
 /// The multipole's reflection and transmission per unit flux reaching its
@@ -108,8 +81,8 @@ impl PaperBsdf {
             for k in 0..NA {
                 let t = k as f64 / (NA - 1) as f64;
                 let att = fe.att_with_sqrt(t);
-                let ess = lerp_tab_sqrt(&self.ess_tab[e], t);
-                let d = lerp_tab_sqrt(&d_nodes, t);
+                let ess = lerp_nodes(&self.ess_tab[e], t);
+                let d = lerp_nodes(&d_nodes, t);
                 let mut w = Rgb::ZERO;
                 for c in 0..3 {
                     w.0[c] = (self.albedo.0[c] * (att - d.0[c]) - att * ess.0[c]).max(0.0);
@@ -177,7 +150,7 @@ impl PaperBsdf {
                 } else {
                     Rgb::ZERO
                 };
-                let sub = (lerp_tab_sqrt(&self.ess_tab[e], t) + ms) * att + d;
+                let sub = (lerp_nodes(&self.ess_tab[e], t) + ms) * att + d;
                 let room = (1.0 - fe.r_out_with_sqrt(t)).max(0.0);
                 let s = sub.max_channel();
                 if s > room {
@@ -403,12 +376,12 @@ impl PaperBsdf {
             fx.r_out_with_sqrt(st)
         };
         present[Lobe::Surface as usize] = !fx.is_index_matched();
-        est[Lobe::Single] = att_o * lerp_tab_sqrt(&self.ess_tab[x], st).mean() * self.kappa;
+        est[Lobe::Single] = att_o * lerp_nodes(&self.ess_tab[x], st).mean() * self.kappa;
         present[Lobe::Single as usize] =
             self.phase.weight() > 0.0 && self.albedo.max_channel() > 0.0 && est[Lobe::Single] > NEGLIGIBLE;
         let lobes = fx.r_lobes_with_sqrt(st);
         if self.opts.energy_bound {
-            let w = lerp_rgb_sqrt(&self.w_tab[x], st);
+            let w = lerp_nodes(&self.w_tab[x], st);
             est[Lobe::MultipleR] = (self.ms_share[x].0 * w).mean() + lobes;
             est[Lobe::MultipleT] = (self.ms_share[x].1 * w).mean();
         } else {

@@ -3,8 +3,8 @@
 //! of [`super::build`], with the geometry (inside cosines, phase function)
 //! that `eval` and `pdf` share.
 
-use super::build::{lerp_rgb_sqrt, NP};
 use super::face::to_face_frame;
+use super::tables::{lerp_nodes, NP};
 use super::{grazing, side, single, Component, ComponentSet, PaperBsdf, TAU_DROP};
 use crate::spectrum::Rgb;
 use glam::{DVec2, DVec3};
@@ -144,7 +144,7 @@ impl PaperBsdf {
         let mut sub = Rgb::ZERO;
         if set.contains(Component::Multiple) {
             if self.opts.energy_bound {
-                let (we, wx) = (lerp_rgb_sqrt(&self.w_tab[e], si), lerp_rgb_sqrt(&self.w_tab[x], so));
+                let (we, wx) = (lerp_nodes(&self.w_tab[e], si), lerp_nodes(&self.w_tab[x], so));
                 let c = if reflect { self.ms_r[e] } else { self.ms_t };
                 sub += c * we * wx;
             } else {

@@ -35,13 +35,13 @@
 //! The back face (`z = -d`) is the same kind of object seen with `z` flipped:
 //! [`to_face_frame`] maps a direction on the back side to the face's frame.
 
+use super::tables::{hemispherical, hemispherical_of_table, lerp_mu, lerp_nodes, node_at, NA};
 use super::Side;
 use crate::boundary::{critical_mu, SurfaceIntegrals};
 use crate::dielectric::{Interface, RoughDielectric};
 use crate::fresnel::fresnel_dielectric;
 use crate::microfacet::{Distribution, Microfacet};
 use crate::params::{FaceScattering, ParamError};
-use crate::quadrature::gauss_legendre_01;
 use crate::sheet::Sheet;
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -71,72 +71,6 @@ fn reflection_half(wi: DVec3, wo: DVec3) -> Option<(f64, f64)> {
     }
     let zs = wi.z + wo.z;
     Some((zs * zs / (2.0 * k), 0.5 * k))
-}
-
-/// Nodes of the per-face tables in the outside cosine (`mu = t^2`, `t` uniform).
-pub(crate) const NA: usize = 65;
-
-/// [`lerp_sqrt`] at `mu`.
-#[inline]
-fn lerp_t(tab: &[f64; NA], mu: f64) -> f64 {
-    lerp_sqrt(tab, mu.abs().min(1.0).sqrt())
-}
-
-/// The interval `i` of the [`NA`] node tables that holds `st` (in `[0, 1]`)
-/// and the fraction `f` of the way from node `i` to `i + 1`: the weights of
-/// every linear interpolation of those tables.
-#[inline]
-pub(crate) fn node_at(st: f64) -> (usize, f64) {
-    let x = st * (NA - 1) as f64;
-    let i = (x as usize).min(NA - 2);
-    (i, x - i as f64)
-}
-
-/// Linear interpolation of a node table at `mu = st^2` for a precomputed `st = sqrt(min(|mu|, 1))`.
-#[inline]
-pub(crate) fn lerp_sqrt(tab: &[f64; NA], st: f64) -> f64 {
-    let (i, f) = node_at(st);
-    tab[i] * (1.0 - f) + tab[i + 1] * f
-}
-
-/// `2 int_0^1 g(mu) mu dmu` of a table interpolated by [`lerp_sqrt`]: with
-/// `mu = t^2` the integrand is `4 t^3 g(t)`, a polynomial of degree 4 on each
-/// interval, integrated exactly by 3-point Gauss-Legendre per interval. Energy
-/// checks rely on this being the integral of exactly what `eval` interpolates.
-pub(crate) fn hemispherical_of_table(tab: &[f64; NA]) -> f64 {
-    const X: [f64; 3] = [0.112_701_665_379_258_31, 0.5, 0.887_298_334_620_741_7];
-    const W: [f64; 3] = [5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0];
-    let h = 1.0 / (NA - 1) as f64;
-    let mut s = 0.0;
-    for i in 0..NA - 1 {
-        for (x, w) in X.iter().zip(W) {
-            let t = (i as f64 + x) * h;
-            let g = tab[i] * (1.0 - x) + tab[i + 1] * x;
-            s += w * h * 4.0 * t * t * t * g;
-        }
-    }
-    s
-}
-
-/// `2 int_0^1 g(mu) mu dmu` of a function by Gauss-Legendre in `t = sqrt(mu)`
-/// on `[0, t_c]` and `[t_c, 1]` (a kink of total internal reflection at
-/// `mu = t_c^2` falls on the split).
-fn hemispherical(g: impl Fn(f64) -> f64, mu_split: f64) -> f64 {
-    static GL: std::sync::OnceLock<(Vec<f64>, Vec<f64>)> = std::sync::OnceLock::new();
-    let (x, w) = GL.get_or_init(|| gauss_legendre_01(24));
-    let tc = mu_split.clamp(0.0, 1.0).sqrt();
-    let mut s = 0.0;
-    for (lo, hi) in [(0.0, tc), (tc, 1.0)] {
-        let len = hi - lo;
-        if len <= 0.0 {
-            continue;
-        }
-        for (xi, wi) in x.iter().zip(w) {
-            let t = lo + len * xi;
-            s += wi * len * 4.0 * t * t * t * g(t * t);
-        }
-    }
-    s
 }
 
 /// The rough (or smooth, or index-matched) interface of a face with the
@@ -471,7 +405,7 @@ impl Face {
         if self.exact_smooth {
             return 1.0 - fresnel_dielectric(mu.abs().min(1.0), self.bd.eta);
         }
-        lerp_t(&self.att_tab, mu)
+        lerp_mu(&self.att_tab, mu)
     }
 
     /// [`Face::att`] at `mu` given also `st = sqrt(min(|mu|, 1))`.
@@ -483,7 +417,7 @@ impl Face {
         if self.exact_smooth {
             return 1.0 - fresnel_dielectric(st * st, self.bd.eta);
         }
-        lerp_sqrt(&self.att_tab, st)
+        lerp_nodes(&self.att_tab, st)
     }
 
     /// The collimated part of [`Face::att`] (what direct transmission carries), given `st`.
@@ -495,7 +429,7 @@ impl Face {
         if self.exact_smooth {
             return 1.0 - fresnel_dielectric(st * st, self.bd.eta);
         }
-        lerp_sqrt(&self.att_dir_tab, st)
+        lerp_nodes(&self.att_dir_tab, st)
     }
 
     /// Directional reflectance for light from outside at cosine `mu`, every
@@ -505,7 +439,7 @@ impl Face {
         if self.exact_smooth {
             return fresnel_dielectric(mu.abs().min(1.0), self.bd.eta);
         }
-        lerp_t(&self.r_tab, mu)
+        lerp_mu(&self.r_tab, mu)
     }
 
     /// [`Face::r_out`] given `st = sqrt(min(|mu|, 1))`.
@@ -514,13 +448,13 @@ impl Face {
         if self.exact_smooth {
             return fresnel_dielectric(st * st, self.bd.eta);
         }
-        lerp_sqrt(&self.r_tab, st)
+        lerp_nodes(&self.r_tab, st)
     }
 
     /// Albedo of the separable reflection lobes alone, given `st`.
     #[inline]
     pub fn r_lobes_with_sqrt(&self, st: f64) -> f64 {
-        lerp_sqrt(&self.r_lobes_tab, st)
+        lerp_nodes(&self.r_lobes_tab, st)
     }
 
     /// `rho_in`: hemispherical reflectance for diffuse light from inside the base.
@@ -632,7 +566,7 @@ impl Face {
     #[inline]
     pub fn lobes_reflection(&self, si: f64, so: f64) -> f64 {
         let node = |st: f64| {
-            let (i, f) = node_at(st);
+            let (i, f) = node_at::<NA>(st);
             let (a, b) = (self.lobe_tab[i], self.lobe_tab[i + 1]);
             [a[0] * (1.0 - f) + b[0] * f, a[1] * (1.0 - f) + b[1] * f]
         };

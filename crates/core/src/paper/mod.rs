@@ -79,17 +79,19 @@ pub(crate) mod face;
 pub mod multipole;
 mod sample;
 pub mod single;
+mod tables;
 
 use crate::params::{PaperParams, ParamError};
 use crate::phase::HgLobes;
 use crate::sheet::Sheet;
 use crate::spectrum::Rgb;
-use build::{lerp_tab, multipole_shares, NP, NS};
+use build::multipole_shares;
 use direct::SheetKernel;
 use eval::LobeProbs;
-use face::{Face, NA};
+use face::Face;
 use glam::DVec3;
 use std::f64::consts::PI;
+use tables::{lerp_mu, NA, NP, NS};
 
 pub use component::{Component, ComponentSet};
 
@@ -484,6 +486,6 @@ impl PaperBsdf {
     /// Albedo of the single-scattering term (reflection plus transmission) per
     /// unit flux *entering* through `face` at outside cosine `mu` (tabulated).
     pub fn single_scattering_albedo(&self, face: Side, mu: f64) -> Rgb {
-        lerp_tab(&self.ess_tab[face], mu)
+        lerp_mu(&self.ess_tab[face], mu)
     }
 }
