@@ -2,8 +2,8 @@
 //! neighbouring nodes computed directly (no table file needed), against direct
 //! quadrature at random `mu`. Run:
 //! `cargo run --release -p paperbsdf-core --example eta_m_interp_error`.
+use paperbsdf_core::boundary::tables::*;
 use paperbsdf_core::boundary::{dir_at_mu, directional_albedo_n, hemispherical_inside, SurfaceIntegrals};
-use paperbsdf_core::boundary_tables::*;
 use paperbsdf_core::*;
 use rand::{Rng, SeedableRng};
 fn main() {

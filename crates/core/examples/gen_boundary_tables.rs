@@ -1,7 +1,7 @@
-//! Writes crates/core/data/boundary_tables.bin (see `paperbsdf_core::boundary_tables`).
+//! Writes crates/core/data/boundary_tables.bin (see `paperbsdf_core::boundary::tables`).
 //! Run: `cargo run --release -p paperbsdf-core --example gen_boundary_tables`.
+use paperbsdf_core::boundary::tables::*;
 use paperbsdf_core::boundary::SurfaceIntegrals;
-use paperbsdf_core::boundary_tables::*;
 use paperbsdf_core::{Distribution, RoughDielectric};
 use std::sync::atomic::{AtomicUsize, Ordering};
 

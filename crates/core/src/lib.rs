@@ -46,7 +46,6 @@
 #![warn(missing_docs)]
 
 pub mod boundary;
-pub mod boundary_tables;
 pub mod bsdf;
 pub mod dielectric;
 pub mod fresnel;

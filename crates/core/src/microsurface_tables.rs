@@ -5,7 +5,7 @@
 //! compensation of energy-conserving faces (DESIGN.md 4.1).
 //!
 //! At every other (distribution, eta, m) node of the grid of
-//! [`crate::boundary_tables`] ([`eta_node`], [`m_node`]: 25 x 25 per
+//! [`crate::boundary::tables`] ([`eta_node`], [`m_node`]: 25 x 25 per
 //! distribution, the same coordinates) the table holds four cosine-weighted hemispherical averages,
 //! each `2 int_0^1 X(mu) mu dmu`, flux fractions (no `eta^2`):
 //! `r_out2`, `t_out2` (light from outside reflected / transmitted by orders >= 2)
@@ -23,7 +23,7 @@
 //! nodes are the limit `eta -> 1+` of a rough face (an index-matched
 //! microsurface still masks, and its walk returns that light).
 
-use crate::boundary_tables::{eta_node, m_node};
+use crate::boundary::tables::{eta_node, m_node};
 use crate::microfacet::{Distribution, Microfacet};
 use crate::microsurface::Microsurface;
 use glam::DVec3;
@@ -35,16 +35,16 @@ pub const TABLE_WALKS: usize = 24_000;
 /// a node here (the lost energy is smooth in (eta, m); the interpolation error
 /// of the coarser grid is measured in the tests).
 pub const STRIDE: usize = 2;
-/// Nodes in eta (`boundary_tables::eta_node(STRIDE * i)`).
-pub const N_ETA: usize = (crate::boundary_tables::N_ETA - 1) / STRIDE + 1;
-/// Nodes in m (`boundary_tables::m_node(STRIDE * j)`).
-pub const N_M: usize = (crate::boundary_tables::N_M - 1) / STRIDE + 1;
+/// Nodes in eta (`boundary::tables::eta_node(STRIDE * i)`).
+pub const N_ETA: usize = (crate::boundary::tables::N_ETA - 1) / STRIDE + 1;
+/// Nodes in m (`boundary::tables::m_node(STRIDE * j)`).
+pub const N_M: usize = (crate::boundary::tables::N_M - 1) / STRIDE + 1;
 /// f32 values per node: `r_out2, t_out2, r_in2, t_in2` and their standard errors.
 pub const NODE_LEN: usize = 8;
 /// Number of f32 values in the table file.
 pub const TABLE_LEN: usize = 2 * N_ETA * N_M * NODE_LEN;
 
-/// Offset of node (dist, i, j) in the table (the layout of `boundary_tables`).
+/// Offset of node (dist, i, j) in the table (the layout of `boundary::tables`).
 pub fn node_offset(dist: Distribution, i: usize, j: usize) -> usize {
     let d = match dist {
         Distribution::Ggx => 0,
@@ -238,7 +238,7 @@ fn cell(s: f64, n: usize) -> (usize, f64) {
 }
 
 /// The orders >= 2 fractions of the face (dist, eta, m), bilinear in the
-/// coordinates of [`crate::boundary_tables`] (`sqrt((eta - 1) / 4)`,
+/// coordinates of [`crate::boundary::tables`] (`sqrt((eta - 1) / 4)`,
 /// `sqrt(m / (pi / 2))`). `eta` in [1, 5], `m` in [0, pi/2] (validate with
 /// [`crate::RoughDielectric::new`]; values beyond are read at the grid's
 /// edge). Continuous down to `m = 0` and `eta = 1`, where the nodes hold the
@@ -272,7 +272,7 @@ pub fn lost_energy(dist: Distribution, eta: f64, m: f64) -> LostEnergy {
 }
 
 /// `(eta, m)` of node (i, j): those of node `(STRIDE i, STRIDE j)` of
-/// [`crate::boundary_tables`].
+/// [`crate::boundary::tables`].
 pub fn node_eta_m(i: usize, j: usize) -> (f64, f64) {
     (eta_node(STRIDE * i), m_node(STRIDE * j))
 }

@@ -3,8 +3,8 @@
 //! at every node, reciprocity `t_out2 = eta^2 t_in2` at every node, and the
 //! interpolated values against direct walk estimates off the nodes.
 
+use paperbsdf_core::boundary::tables::{eta_node, m_node};
 use paperbsdf_core::boundary::SurfaceIntegrals;
-use paperbsdf_core::boundary_tables::{eta_node, m_node};
 use paperbsdf_core::microsurface_tables::{hemispherical_estimate, lost_energy, node, node_eta_m, N_ETA, N_M, STRIDE};
 use paperbsdf_core::{Distribution, RoughDielectric};
 use rand::{Rng, SeedableRng};

@@ -58,7 +58,7 @@ pub fn encode_node(s: &SurfaceIntegrals) -> Vec<f32> {
     v
 }
 
-static TABLE_BYTES: &[u8] = include_bytes!("../data/boundary_tables.bin");
+static TABLE_BYTES: &[u8] = include_bytes!("../../data/boundary_tables.bin");
 
 fn table() -> &'static [f32] {
     static TABLE: OnceLock<Vec<f32>> = OnceLock::new();

@@ -11,6 +11,8 @@
 //! `w`, `R(w) = E[F(w.h) G1(r)]` and `T(w) = E[(1 - F) G1(t)]`, an integrand that
 //! is smooth in `u` even for a nearly smooth surface.
 
+pub mod tables;
+
 use crate::dielectric::{Interface, RoughDielectric};
 use crate::fresnel::fresnel_dielectric;
 use crate::geometry::{reflect, refract};
@@ -269,7 +271,7 @@ impl SurfaceIntegrals {
                 tbar_in: 1.0,
             },
             Interface::Smooth => Self::smooth(b.eta),
-            Interface::Rough(_) => crate::boundary_tables::interpolate(b.dist, b.eta, b.m),
+            Interface::Rough(_) => crate::boundary::tables::interpolate(b.dist, b.eta, b.m),
         }
     }
 
