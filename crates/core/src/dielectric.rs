@@ -20,7 +20,7 @@
 use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample, TransportMode};
 use crate::fresnel::fresnel_dielectric;
 use crate::geometry::{reflect, refract};
-use crate::microfacet::{Distribution, Microfacet};
+use crate::microfacet::{upper_unit, Distribution, Microfacet};
 use crate::params::ParamError;
 use crate::spectrum::Rgb;
 use glam::DVec3;
@@ -107,15 +107,9 @@ impl RoughDielectric {
         }
         let is_reflect = cv * cl > 0.0;
         let eta_rel = self.eta_rel(v);
-        let mut h = if is_reflect { v + l } else { v + l * eta_rel };
-        let hl = h.length();
-        if hl == 0.0 || !hl.is_finite() {
+        let Some(h) = upper_unit(if is_reflect { v + l } else { v + l * eta_rel }) else {
             return 0.0;
-        }
-        h /= hl;
-        if h.z < 0.0 {
-            h = -h;
-        }
+        };
         let d = mf.d(h);
         if d == 0.0 {
             return 0.0;
@@ -153,15 +147,9 @@ impl RoughDielectric {
         }
         let is_reflect = v.z * l.z > 0.0;
         let eta_rel = self.eta_rel(v);
-        let mut h = if is_reflect { v + l } else { v + l * eta_rel };
-        let hl = h.length();
-        if hl == 0.0 || !hl.is_finite() {
+        let Some(h) = upper_unit(if is_reflect { v + l } else { v + l * eta_rel }) else {
             return 0.0;
-        }
-        h /= hl;
-        if h.z < 0.0 {
-            h = -h;
-        }
+        };
         let (vh, lh) = (v.dot(h), l.dot(h));
         // The microfacet must face both directions from their own sides.
         if vh * v.z <= 0.0 || lh * l.z <= 0.0 {

@@ -284,7 +284,10 @@ impl Microfacet {
         }
     }
 
-    fn sample_visible_ggx(&self, w: DVec3, u: [f64; 2]) -> DVec3 {
+    /// GGX visible normals for `w` (Heitz 2018): valid for `w` above or below
+    /// the horizon (below, the visible part of the stretched hemisphere
+    /// projects to a half-disk minus a half-ellipse); the micro-normal has `z > 0`.
+    pub(crate) fn sample_visible_ggx(&self, w: DVec3, u: [f64; 2]) -> DVec3 {
         // Heitz 2018: stretch, sample a projected disk, unstretch.
         let a = self.alpha;
         let vh = DVec3::new(a * w.x, a * w.y, w.z).normalize();
@@ -527,6 +530,20 @@ pub fn erfinv_approx(y: f64) -> f64 {
         x = p * y;
     }
     x
+}
+
+/// `h / |h|` turned to the upper hemisphere (`z >= 0`): the unit micro-normal
+/// of an unnormalised half vector (Walter et al. 2007, eq. 16, for reflection
+/// `wi + wo` and for refraction `wi + eta wo` up to sign); `None` for a zero
+/// or non-finite `h`.
+#[inline]
+pub(crate) fn upper_unit(h: DVec3) -> Option<DVec3> {
+    let hl = h.length();
+    if hl == 0.0 || !hl.is_finite() {
+        return None;
+    }
+    let h = h / hl;
+    Some(if h.z < 0.0 { -h } else { h })
 }
 
 #[cfg(test)]

@@ -57,8 +57,8 @@
 use crate::bsdf::TransportMode;
 use crate::dielectric::{Interface, RoughDielectric};
 use crate::fresnel::fresnel_dielectric;
-use crate::geometry::{reflect, refract, sin_cos_2pi};
-use crate::microfacet::{beckmann_slope_y, Distribution, Microfacet};
+use crate::geometry::{reflect, refract};
+use crate::microfacet::{beckmann_slope_y, upper_unit, Distribution, Microfacet};
 use glam::DVec3;
 
 /// Scattering events after which a walk is cut (see the module doc).
@@ -296,22 +296,7 @@ impl Microsurface {
         match self.mf.dist {
             Distribution::Ggx => {
                 let (u0, u1) = (rnd(), rnd());
-                let vh = DVec3::new(a * w.x, a * w.y, w.z).normalize();
-                let lensq = vh.x * vh.x + vh.y * vh.y;
-                let t1 = if lensq > 0.0 {
-                    DVec3::new(-vh.y, vh.x, 0.0) / lensq.sqrt()
-                } else {
-                    DVec3::X
-                };
-                let t2 = vh.cross(t1);
-                let r = u0.sqrt();
-                let (sin_phi, cos_phi) = sin_cos_2pi(u1);
-                let p1 = r * cos_phi;
-                let s = 0.5 * (1.0 + vh.z);
-                let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sin_phi;
-                let p3 = (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
-                let nh = p1 * t1 + p2 * t2 + p3 * vh;
-                DVec3::new(a * nh.x, a * nh.y, nh.z.max(1e-12)).normalize()
+                self.mf.sample_visible_ggx(w, [u0, u1])
             }
             Distribution::Beckmann => {
                 if w.z >= 0.0 {
@@ -423,15 +408,9 @@ impl Microsurface {
             self.visible_density(i, h) * fresnel_dielectric(ih, eta_l) / (4.0 * ih)
         } else {
             // Refraction into the other medium (relative index eta_l).
-            let mut h = -(i + eta_l * o);
-            let hl = h.length();
-            if hl == 0.0 || !hl.is_finite() {
+            let Some(h) = upper_unit(-(i + eta_l * o)) else {
                 return 0.0;
-            }
-            h /= hl;
-            if h.z < 0.0 {
-                h = -h;
-            }
+            };
             let (ih, oh) = (i.dot(h), o.dot(h));
             if ih <= 0.0 || oh >= 0.0 {
                 return 0.0;
