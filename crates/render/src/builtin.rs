@@ -9,8 +9,9 @@
 //! - `lightbox`: four layers of cut paper (masks from PNG files) in front of a
 //!   light panel, like a paper-cut light box.
 
+use crate::error::SceneError;
 use crate::scene::Scene;
-use crate::spec::{load_scene_str, Resources, SceneError};
+use crate::spec::{load_scene_str, Resources};
 use std::collections::HashMap;
 
 /// `(name, scene file text, embedded files)`.

@@ -6,6 +6,7 @@
 //! The PNG's tone map is a clamp of `exposure * L` followed by the sRGB
 //! transfer function (IEC 61966-2-1).
 
+use crate::error::RenderError;
 use paperbsdf_core::Rgb;
 use std::path::Path;
 
@@ -36,15 +37,6 @@ impl Film {
             count: vec![0; n],
         }
     }
-    /// Adds one sample to pixel `i`.
-    #[inline]
-    pub fn add(&mut self, i: usize, v: Rgb) {
-        for c in 0..3 {
-            self.sum[i][c] += v.0[c];
-            self.sum_sq[i][c] += v.0[c] * v.0[c];
-        }
-        self.count[i] += 1;
-    }
     /// The pixel's mean radiance (zero before any sample).
     pub fn mean(&self, i: usize) -> Rgb {
         let n = self.count[i].max(1) as f64;
@@ -73,12 +65,22 @@ impl Film {
 /// Writes `write(tmp)` then renames it to `path`, with the project's shared
 /// atomic writer (symbolic links written through, non-regular targets refused,
 /// temporary files removed by the Ctrl-C handler).
-fn atomic(path: &Path, write: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), String> {
-    paperbsdf_io::atomic::write_atomic_with(path, write).map_err(|e| e.to_string())
+fn atomic(path: &Path, write: impl FnOnce(&Path) -> Result<(), RenderError>) -> Result<(), RenderError> {
+    paperbsdf_io::atomic::write_atomic_with(path, write).map_err(RenderError::Output)
+}
+
+/// The error of reading or writing the image file `path` in `format`.
+fn file_error(verb: &'static str, format: &'static str, path: &Path, reason: impl std::fmt::Display) -> RenderError {
+    RenderError::ImageFile {
+        verb,
+        format,
+        path: path.to_path_buf(),
+        reason: reason.to_string(),
+    }
 }
 
 /// Writes a linear RGB image (row-major, top row first) as 32-bit float OpenEXR, atomically.
-pub fn write_exr(path: &Path, width: usize, height: usize, pixels: &[Rgb]) -> Result<(), String> {
+pub fn write_exr(path: &Path, width: usize, height: usize, pixels: &[Rgb]) -> Result<(), RenderError> {
     use exr::prelude::*;
     atomic(path, |tmp| {
         let layer = Layer::new(
@@ -93,12 +95,12 @@ pub fn write_exr(path: &Path, width: usize, height: usize, pixels: &[Rgb]) -> Re
         Image::from_layer(layer)
             .write()
             .to_file(tmp)
-            .map_err(|e| format!("cannot write EXR '{}': {e}", path.display()))
+            .map_err(|e| file_error("write", "EXR", path, e))
     })
 }
 
 /// Reads the RGB channels of an OpenEXR file: `(width, height, pixels)`, top row first.
-pub fn read_exr(path: &Path) -> Result<(usize, usize, Vec<Rgb>), String> {
+pub fn read_exr(path: &Path) -> Result<(usize, usize, Vec<Rgb>), RenderError> {
     use exr::prelude::*;
     let img = read_first_rgba_layer_from_file(
         path,
@@ -107,7 +109,7 @@ pub fn read_exr(path: &Path) -> Result<(usize, usize, Vec<Rgb>), String> {
             px[pos.y() * *w + pos.x()] = Rgb::new(r as f64, g as f64, b as f64);
         },
     )
-    .map_err(|e| format!("cannot read EXR '{}': {e}", path.display()))?;
+    .map_err(|e| file_error("read", "EXR", path, e))?;
     let (w, h, px) = img.layer_data.channel_data.pixels;
     Ok((w, h, px))
 }
@@ -122,7 +124,7 @@ pub fn linear_to_srgb(v: f64) -> f64 {
 }
 
 /// Writes `exposure * pixels`, clamped and sRGB-encoded, as an 8-bit PNG, atomically.
-pub fn write_png(path: &Path, width: usize, height: usize, pixels: &[Rgb], exposure: f64) -> Result<(), String> {
+pub fn write_png(path: &Path, width: usize, height: usize, pixels: &[Rgb], exposure: f64) -> Result<(), RenderError> {
     let mut buf = Vec::with_capacity(width * height * 3);
     for p in pixels {
         for c in 0..3 {
@@ -131,9 +133,9 @@ pub fn write_png(path: &Path, width: usize, height: usize, pixels: &[Rgb], expos
             buf.push((linear_to_srgb(v) * 255.0 + 0.5) as u8);
         }
     }
-    let img = image::RgbImage::from_raw(width as u32, height as u32, buf).ok_or("image buffer size mismatch")?;
+    let img = image::RgbImage::from_raw(width as u32, height as u32, buf).ok_or(RenderError::BufferSize)?;
     atomic(path, |tmp| {
         img.save_with_format(tmp, image::ImageFormat::Png)
-            .map_err(|e| format!("cannot write PNG '{}': {e}", path.display()))
+            .map_err(|e| file_error("write", "PNG", path, e))
     })
 }

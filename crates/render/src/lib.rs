@@ -17,19 +17,22 @@
 #![warn(missing_docs)]
 
 pub mod builtin;
+pub mod error;
 pub mod film;
 pub mod integrator;
 pub mod material;
 pub mod math;
+pub mod mesh;
 pub mod paper_model;
 pub mod scene;
 pub mod shapes;
 pub mod spec;
 pub mod texture;
 
+pub use error::{ImageError, RenderError, SceneError};
 pub use film::Film;
 pub use scene::{Scene, Settings};
-pub use spec::{load_scene, load_scene_str, SceneError};
+pub use spec::{load_scene, load_scene_str};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use math::{mix64, Pcg32};
@@ -186,7 +189,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
 /// at the next tile and the partial image is still written). A second Ctrl-C
 /// removes every temporary output file being written and exits at once with
 /// code 130. Fails if a handler is installed already.
-pub fn install_ctrlc_flag() -> Result<&'static AtomicBool, String> {
+pub fn install_ctrlc_flag() -> Result<&'static AtomicBool, RenderError> {
     static FLAG: AtomicBool = AtomicBool::new(false);
     ctrlc::set_handler(|| {
         if FLAG.swap(true, Ordering::SeqCst) {
@@ -195,7 +198,7 @@ pub fn install_ctrlc_flag() -> Result<&'static AtomicBool, String> {
         }
         eprintln!("\ninterrupted: finishing the current tiles and writing the partial image (Ctrl-C again to quit)");
     })
-    .map_err(|e| format!("cannot install the Ctrl-C handler: {e}"))?;
+    .map_err(RenderError::CtrlC)?;
     Ok(&FLAG)
 }
 
@@ -228,14 +231,15 @@ pub fn available_memory_bytes() -> Option<f64> {
 
 /// Refuses an image whose estimated memory ([`estimate_memory_bytes`]) is more
 /// than `available` bytes, with both numbers in the message.
-pub fn check_memory(width: usize, height: usize, available: Option<f64>) -> Result<(), String> {
+pub fn check_memory(width: usize, height: usize, available: Option<f64>) -> Result<(), RenderError> {
     let need = estimate_memory_bytes(width, height);
     match available {
-        Some(a) if need > a => Err(format!(
-            "a {width}x{height} render needs about {:.1} GB of memory, more than the {:.1} GB available; use a smaller --width/--height",
-            need / 1e9,
-            a / 1e9
-        )),
+        Some(available) if need > available => Err(RenderError::Memory {
+            width,
+            height,
+            need,
+            available,
+        }),
         _ => Ok(()),
     }
 }
@@ -246,15 +250,15 @@ pub fn render_with_threads(
     opts: &RenderOptions,
     cancel: &AtomicBool,
     threads: Option<usize>,
-) -> Result<(RenderOutput, usize), String> {
+) -> Result<(RenderOutput, usize), RenderError> {
     if threads == Some(0) {
-        return Err("--threads must be at least 1".into());
+        return Err(RenderError::NoThreads);
     }
     check_memory(scene.settings.width, scene.settings.height, available_memory_bytes())?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()
-        .map_err(|e| format!("cannot start the worker threads: {e}"))?;
+        .map_err(RenderError::Threads)?;
     let n = pool.current_num_threads();
     Ok((pool.install(|| render(scene, opts, cancel)), n))
 }

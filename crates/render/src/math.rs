@@ -5,6 +5,7 @@
 //! and Mitsuba 3 use); the seeding hash is SplitMix64's finaliser (Steele et al. 2014).
 
 use glam::{DMat3, DVec3};
+use paperbsdf_core::geometry::coordinate_system;
 
 /// A ray `o + t d` with a valid parameter interval `(0, t_max)`.
 #[derive(Clone, Copy, Debug)]
@@ -46,13 +47,10 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// A frame around the unit normal `n` (Duff et al. 2017, "Building an orthonormal basis, revisited").
+    /// A frame around the unit normal `n`, the tangents from
+    /// [`paperbsdf_core::geometry::coordinate_system`] (Duff et al. 2017).
     pub fn from_normal(n: DVec3) -> Self {
-        let sign = 1.0f64.copysign(n.z);
-        let a = -1.0 / (sign + n.z);
-        let b = n.x * n.y * a;
-        let s = DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-        let t = DVec3::new(b, sign + n.y * n.y * a, -n.y);
+        let (s, t) = coordinate_system(n);
         Frame { s, t, n }
     }
     /// World direction to local coordinates.

@@ -6,6 +6,7 @@
 //! otherwise and emits on the side its geometric normal points to; the camera's
 //! field of view is horizontal; pixel `(0, 0)` is the top-left one.
 
+use crate::error::RenderError;
 use crate::material::Material;
 use crate::math::{mix64, Ray};
 use crate::shapes::{Bvh, PrimHit, Shape};
@@ -36,10 +37,10 @@ impl Camera {
     /// A camera at `origin` looking at `target` with approximate `up`; `fov_x_deg` is the horizontal field of view.
     /// `up` (any length) must make an angle whose sine is at least [`UP_MIN_SIN`]
     /// with the view direction.
-    pub fn look_at(origin: DVec3, target: DVec3, up: DVec3, fov_x_deg: f64) -> Result<Camera, String> {
+    pub fn look_at(origin: DVec3, target: DVec3, up: DVec3, fov_x_deg: f64) -> Result<Camera, RenderError> {
         let forward = (target - origin).normalize_or_zero();
         if forward == DVec3::ZERO {
-            return Err("camera origin and target coincide".into());
+            return Err(RenderError::CameraTarget);
         }
         // Parallel within a tolerance: rounding makes the cross product of
         // parallel vectors tiny but not zero, and normalising it would give a
@@ -47,17 +48,11 @@ impl Camera {
         let up_n = up.normalize_or_zero();
         let sin = forward.cross(up_n).length();
         if sin.is_nan() || sin < UP_MIN_SIN {
-            return Err(format!(
-                "camera `up` = ({}, {}, {}) is parallel to the viewing direction (the angle between them must be at least {:.4} degrees)",
-                up.x,
-                up.y,
-                up.z,
-                UP_MIN_SIN.asin().to_degrees()
-            ));
+            return Err(RenderError::CameraUp { up });
         }
         let right = forward.cross(up_n).normalize();
         if !(fov_x_deg > 0.0 && fov_x_deg < 180.0) {
-            return Err(format!("camera fov = {fov_x_deg} is outside (0, 180) degrees"));
+            return Err(RenderError::CameraFov { fov: fov_x_deg });
         }
         let up = right.cross(forward);
         Ok(Camera {

@@ -317,13 +317,12 @@ impl Bvh {
             order: Vec::with_capacity(shapes.len()),
         };
         if !items.is_empty() {
-            let n = items.len();
-            bvh.build_rec(&mut items[..], 0, n);
+            bvh.build_rec(&mut items[..]);
         }
         bvh
     }
 
-    fn build_rec(&mut self, items: &mut [BuildItem], _lo: usize, _hi: usize) -> usize {
+    fn build_rec(&mut self, items: &mut [BuildItem]) -> usize {
         let bounds = items.iter().fold(Aabb::EMPTY, |b, it| b.union(it.bounds));
         let node_index = self.nodes.len();
         let make_leaf = |bvh: &mut Bvh, items: &[BuildItem]| {
@@ -415,10 +414,8 @@ impl Bvh {
             axis,
         });
         let (l, r) = items.split_at_mut(mid);
-        let nl = l.len();
-        self.build_rec(l, 0, nl);
-        let nr = r.len();
-        let second = self.build_rec(r, 0, nr);
+        self.build_rec(l);
+        let second = self.build_rec(r);
         self.nodes[node_index].offset = second as u32;
         node_index
     }

@@ -6,6 +6,7 @@
 //! are decoded from sRGB to linear; greyscale maps (masks, thickness and ink
 //! maps) are used as stored, 0 = black, 1 = white, with no gamma.
 
+use crate::error::ImageError;
 use paperbsdf_core::Rgb;
 use std::path::Path;
 use std::sync::Arc;
@@ -42,8 +43,8 @@ impl Image {
     /// or as a greyscale map (`grey = true`, values as stored).
     /// Images larger than [`MAX_IMAGE_SIDE`] on a side, or needing more than
     /// [`MAX_IMAGE_BYTES`] to decode, are refused before anything is allocated.
-    pub fn load(path: &Path, grey: bool) -> Result<Image, String> {
-        let e = |e: image::ImageError| format!("cannot read image '{}': {e}", path.display());
+    pub fn load(path: &Path, grey: bool) -> Result<Image, ImageError> {
+        let e = |e: image::ImageError| ImageError(format!("cannot read image '{}': {e}", path.display()));
         let mut r = image::ImageReader::open(path)
             .map_err(|x| e(x.into()))?
             .with_guessed_format()
@@ -52,8 +53,8 @@ impl Image {
         Ok(Self::from_dynamic(r.decode().map_err(e)?, grey))
     }
     /// Decodes an image held in memory (built-in scenes embed their masks), with the limits of [`Image::load`].
-    pub fn from_bytes(bytes: &[u8], grey: bool) -> Result<Image, String> {
-        let e = |e: image::ImageError| format!("cannot decode embedded image: {e}");
+    pub fn from_bytes(bytes: &[u8], grey: bool) -> Result<Image, ImageError> {
+        let e = |e: image::ImageError| ImageError(format!("cannot decode embedded image: {e}"));
         let mut r = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
             .map_err(|x| e(x.into()))?;
@@ -158,14 +159,6 @@ impl ColourTexture {
                     Rgb::splat(image.bilinear(u, v, 0))
                 }
             }
-        }
-    }
-    /// The largest channel value anywhere (for checks such as albedo <= 1).
-    pub fn max_value(&self) -> f64 {
-        match self {
-            ColourTexture::Constant(c) => c.max_channel(),
-            ColourTexture::Checker { even, odd, .. } => even.max_channel().max(odd.max_channel()),
-            ColourTexture::Image { image, .. } => image.data.iter().fold(0.0f64, |m, &x| m.max(x as f64)),
         }
     }
 }

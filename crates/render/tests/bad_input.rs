@@ -324,3 +324,96 @@ fn camera_up_parallel_within_tolerance() {
     std::fs::write(&p, scene).unwrap();
     load_scene(&p).unwrap();
 }
+
+/// Issue 12: a material table is read by its `type` (one set of keys per
+/// type); `type` may come after other keys, and errors keep their lines.
+#[test]
+fn material_type_and_key_order() {
+    let dir = tempfile::tempdir().unwrap();
+    // `type` after the other keys: the scene loads, the same as with `type` first.
+    let p = dir.path().join("scene.toml");
+    std::fs::write(
+        &p,
+        GOOD.replace(
+            "type = \"paper\"\npreset = \"matte\"",
+            "preset = \"matte\"\nm_f = 0.3\ntype = \"paper\"",
+        ),
+    )
+    .unwrap();
+    let s = load_scene(&p).unwrap();
+    match &s.materials[1] {
+        paperbsdf_render::material::Material::Paper(pm) => assert_eq!(pm.base.m_f, 0.3),
+        _ => panic!("materials[1] is not paper"),
+    }
+    // A typo before `type` is still reported at its line, with every key of every type.
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace(
+            "type = \"paper\"\npreset = \"matte\"",
+            "thicknes = 1\ntype = \"paper\"\npreset = \"matte\"",
+        ),
+    );
+    contains_all(
+        &m,
+        &[
+            "materials.sheet.thicknes",
+            "line 16",
+            "`type`",
+            "`reflectance`",
+            "`m_f`",
+        ],
+    );
+    // A wrong value before `type` names the key.
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace(
+            "type = \"paper\"\npreset = \"matte\"",
+            "m_f = \"x\"\ntype = \"paper\"\npreset = \"matte\"",
+        ),
+    );
+    contains_all(&m, &["materials.sheet", "`m_f`", "invalid type"]);
+    // A key of another type after `type`: its line, and the keys that apply.
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace("preset = \"matte\"", "preset = \"matte\"\neta = 1.5"),
+    );
+    contains_all(
+        &m,
+        &[
+            "materials.sheet.eta",
+            "line 18",
+            "does not apply to a `paper` material",
+            "preset, params, d",
+        ],
+    );
+    // An unknown type lists the types, at the `type` line.
+    let m = load_err(dir.path(), &GOOD.replace("type = \"paper\"", "type = \"papier\""));
+    contains_all(
+        &m,
+        &[
+            "materials.sheet.type",
+            "line 16",
+            "papier",
+            "diffuse, dielectric, paper, measured, black",
+        ],
+    );
+    // A table without `type` is named (not the table before it).
+    let m = load_err(dir.path(), &GOOD.replace("type = \"paper\"\n", ""));
+    contains_all(&m, &["materials.sheet, line 15", "missing field `type`"]);
+    // A paper given in full, without a preset, loads; one key short names the key.
+    let full = "d = 0.1\nsigma_a = 1\nsigma_s = 100\ng_f = 0.8\ng_b = -0.2\nw_b = 0.1\neta_f = 1.5\neta_b = 1.5\nm_f = 0.3\nm_b = 0.3";
+    std::fs::write(&p, GOOD.replace("preset = \"matte\"", full)).unwrap();
+    let s = load_scene(&p).unwrap();
+    match &s.materials[1] {
+        paperbsdf_render::material::Material::Paper(pm) => {
+            assert_eq!(pm.base.dist_f, paperbsdf_core::Distribution::Ggx, "GGX by default");
+            assert_eq!(pm.base.name.as_deref(), Some("materials.sheet"));
+        }
+        _ => panic!("materials[1] is not paper"),
+    }
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace("preset = \"matte\"", &full.replace("\nm_b = 0.3", "")),
+    );
+    contains_all(&m, &["materials.sheet", "paper needs `m_b`"]);
+}
