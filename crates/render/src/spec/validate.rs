@@ -15,6 +15,7 @@ use crate::scene::{Camera, Scene, SceneBuilder, Settings};
 use crate::shapes::Shape;
 use crate::texture::{ColourTexture, GreyTexture};
 use glam::{DMat3, DVec3};
+use paperbsdf_core::models::ModelKind;
 use paperbsdf_core::{Colour, Distribution, FaceScattering, PaperParams, Rgb, RoughDielectric};
 use serde::Deserialize;
 use std::collections::HashMap;
@@ -149,7 +150,7 @@ fn params_file(rel: &str, at: At, res: &Resources) -> Result<PaperParams, SceneE
             rel.to_string()
         };
         let s = paperbsdf_io::read_source_full(&source).map_err(|e| fail(&e))?;
-        if let Some(model) = s.fit_model.as_deref().filter(|m| *m != "paper") {
+        if let Some(model) = s.fit_model.as_deref().filter(|m| *m != ModelKind::Paper.name()) {
             return Err(fail(&format!(
                 "{}: a fit of the model `{model}`; a `paper` material needs a fit of the `paper` model",
                 s.origin
