@@ -84,7 +84,7 @@
 
 use crate::faces::{FaceOptics, StochFace};
 use crate::slab::{Face, Medium, Slab};
-use paperbsdf_core::phase::{hg, sample_hg_cos};
+use paperbsdf_core::phase::{sample_hg_cos, HgLobes};
 use paperbsdf_core::{DVec3, RoughDielectric, TransportMode};
 use rand::Rng;
 use std::f64::consts::PI;
@@ -259,12 +259,12 @@ pub struct Tracer<'a> {
     slab: &'a Slab,
     med: Medium,
     targets: Vec<Target>,
-    /// Phase lobes with `|g| < 1`: (weight, g).
-    smooth_lobes: Vec<(f64, f64)>,
-    /// Phase lobes with `|g| = 1` (Dirac deltas, forward or backward): (weight, g).
-    delta_lobes: Vec<(f64, f64)>,
-    /// All lobes with positive weight, for sampling: (cumulative weight, g, is_delta).
-    lobes: Vec<(f64, f64, bool)>,
+    /// The phase function's lobes `(g, weight)`, forward first
+    /// ([`paperbsdf_core::phase::TwoLobeHg::lobes`]); those with `|g| = 1` are
+    /// Dirac deltas along the propagation direction or against it.
+    lobes: [(f64, f64); 2],
+    /// The lobes with `|g| < 1`, whose density next-event estimation evaluates.
+    smooth: HgLobes,
     /// Whether any rough target uses MIS at volume vertices.
     any_mis_volume: bool,
     /// Scattering events after which a walk is cut (at least 1).
@@ -310,30 +310,12 @@ impl<'a> Tracer<'a> {
             })
             .collect();
         let p = slab.phase();
-        let mut smooth_lobes = Vec::new();
-        let mut delta_lobes = Vec::new();
-        let mut lobes = Vec::new();
-        let mut cum = 0.0;
-        for (w, g) in [(1.0 - p.w_b, p.g_f), (p.w_b, p.g_b)] {
-            if w <= 0.0 {
-                continue;
-            }
-            let is_delta = g.abs() >= 1.0;
-            if is_delta {
-                delta_lobes.push((w, g));
-            } else {
-                smooth_lobes.push((w, g));
-            }
-            cum += w;
-            lobes.push((cum, g, is_delta));
-        }
         let mut t = Tracer {
             slab,
             med: slab.medium(channel),
             targets,
-            smooth_lobes,
-            delta_lobes,
-            lobes,
+            lobes: p.lobes(),
+            smooth: p.smooth_part(),
             any_mis_volume: false,
             max_collisions: MAX_COLLISIONS_PER_WALK,
         };
@@ -343,9 +325,10 @@ impl<'a> Tracer<'a> {
         // phase sampling beat exit sampling at a volume vertex, and only then is
         // its evaluation (a BSDF eval and pdf per target) worth its cost.
         let phase_peak: f64 = t
-            .smooth_lobes
+            .smooth
+            .lobes()
             .iter()
-            .map(|&(w, g)| w * (1.0 + g.abs()) / (4.0 * PI * (1.0 - g.abs()).powi(2)))
+            .map(|&(g, w)| w * (1.0 + g.abs()) / (4.0 * PI * (1.0 - g.abs()).powi(2)))
             .sum();
         let mut rng = rand_pcg::Pcg64Mcg::new(0x5eed);
         for tg in &mut t.targets {
@@ -398,12 +381,6 @@ impl<'a> Tracer<'a> {
         self.targets.len()
     }
 
-    /// The non-delta part of the phase function at cosine `c`.
-    #[inline]
-    fn phase_smooth(&self, c: f64) -> f64 {
-        self.smooth_lobes.iter().map(|&(w, g)| w * hg(c, g)).sum()
-    }
-
     /// Transmittance along `w` over a depth difference `dz`.
     #[inline]
     fn transmittance(&self, dz: f64, w: DVec3) -> f64 {
@@ -430,7 +407,7 @@ impl<'a> Tracer<'a> {
     fn q_p<R: Rng>(&self, v: Vertex, w: DVec3, rng: &mut R) -> (f64, f64) {
         match v {
             Vertex::Volume { prev, .. } => {
-                let q = self.phase_smooth(prev.dot(w));
+                let q = self.smooth.eval(prev.dot(w));
                 (q, q)
             }
             Vertex::Surface { face, w_from_l } => {
@@ -768,28 +745,25 @@ impl<'a> Tracer<'a> {
                 }
                 let v = Vertex::Volume { z, prev: dir };
                 self.nee_exit(v, weight, rng, tally);
-                for &(wl, g) in &self.delta_lobes {
-                    self.nee_dir(v, weight * wl, if g > 0.0 { dir } else { -dir }, None, rng, tally);
-                }
-                // Draw a lobe, then a direction from it.
-                let ul = rng.gen::<f64>() * self.lobes.last().map_or(1.0, |l| l.0);
-                let &(_, g, is_delta) = self
-                    .lobes
-                    .iter()
-                    .find(|l| ul < l.0)
-                    .unwrap_or(&self.lobes[self.lobes.len() - 1]);
-                let new_dir = if is_delta {
-                    if g > 0.0 {
-                        dir
-                    } else {
-                        -dir
+                let along = |g: f64| if g > 0.0 { dir } else { -dir };
+                for (g, wl) in self.lobes {
+                    if wl > 0.0 && g.abs() >= 1.0 {
+                        self.nee_dir(v, weight * wl, along(g), None, rng, tally);
                     }
+                }
+                // Draw a lobe by its weight, delta lobes included (the forward
+                // one for u < w_f / (w_f + w_b)), then a direction from it.
+                let [(g0, w0), (g1, w1)] = self.lobes;
+                let g = if rng.gen::<f64>() * (w0 + w1) < w0 { g0 } else { g1 };
+                let is_delta = g.abs() >= 1.0;
+                let new_dir = if is_delta {
+                    along(g)
                 } else {
                     let c = sample_hg_cos(g, rng.gen());
                     direction_at(dir, c, rng)
                 };
                 if !is_delta && self.any_mis_volume {
-                    let p1 = self.phase_smooth(dir.dot(new_dir));
+                    let p1 = self.smooth.eval(dir.dot(new_dir));
                     self.nee_dir(v, weight, new_dir, Some(p1), rng, tally);
                 }
                 dir = new_dir;
