@@ -4,7 +4,7 @@
 //! Light arrives from direction `wi` (pointing toward the light) at the face
 //! it faces, carrying unit flux. Every event is sampled exactly from the
 //! physical system: surface events from the face's BSDF in importance
-//! transport ([`crate::faces`]: Walter's [`RoughDielectric::sample_mode`], the
+//! transport ([`crate::faces`]: Walter's [`paperbsdf_core::RoughDielectric::sample_mode`], the
 //! microsurface walk, or the sub-walk through a front coating, whose weight is
 //! the fraction of flux carried; smooth and index-matched faces and smooth
 //! coatings are delta events), free paths
