@@ -19,4 +19,4 @@ pub mod measure;
 pub mod pad;
 
 pub use datasheet::{fit_datasheet, Datasheet, DatasheetError, DatasheetFit};
-pub use measure::{measure_model, measure_truth, Measurements, Selection, TruthConfig, METRIC_NAMES};
+pub use measure::{measure_model, measure_truth, MeasureError, Measurements, Selection, TruthConfig, METRIC_NAMES};

@@ -13,11 +13,11 @@
 
 use crate::edge::{self, ScatterDistance};
 use crate::gloss::{self, GEOMETRIES};
-use crate::instrument::{self, luminance, KubelkaMunk, Quality, Reflectances, SheetFactors, GLOSS_TRAP_HALF_ANGLE_DEG};
+use crate::instrument::{self, luminance, KubelkaMunk, Quality, Reflectances, GLOSS_TRAP_HALF_ANGLE_DEG};
 use crate::pad::{simulate_pad, Backing, PadConfig};
 use paperbsdf_core::models::ComponentModel;
-use paperbsdf_core::{DVec3, PaperParams, Rgb};
-use paperbsdf_sim::{simulate_bsdf, simulate_exit_profile, LateralConfig, SimConfig, Slab};
+use paperbsdf_core::{DVec3, PaperParams, ParamError, Rgb};
+use paperbsdf_sim::{simulate_bsdf, simulate_exit_profile, LateralConfig, SimConfig, SimError, Slab};
 use serde::Serialize;
 
 /// Every metric name `measure` knows (the JSON keys).
@@ -34,6 +34,24 @@ pub const METRIC_NAMES: [&str; 10] = [
     "scatter_distance_mm",
 ];
 
+/// Why measurements could not be made: an unknown metric, or parameters or a
+/// simulation request the simulator refuses.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeasureError {
+    /// A metric name that is not one of [`METRIC_NAMES`].
+    #[error("unknown metric `{0}`; known metrics: {known}", known = METRIC_NAMES.join(", "))]
+    UnknownMetric(String),
+    /// An empty list of metrics.
+    #[error("no metric named; known metrics: {known}", known = METRIC_NAMES.join(", "))]
+    NoMetric,
+    /// The sheet's parameters are invalid.
+    #[error(transparent)]
+    Params(#[from] ParamError),
+    /// The simulator refused a run.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+}
+
 /// Which metrics to compute.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Selection(pub Vec<&'static str>);
@@ -45,21 +63,16 @@ impl Selection {
     }
     /// Parses a comma-separated list of metric names; an unknown name is an
     /// error that lists the known ones.
-    pub fn parse(list: &str) -> Result<Self, String> {
+    pub fn parse(list: &str) -> Result<Self, MeasureError> {
         let mut v = Vec::new();
         for name in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
             match METRIC_NAMES.iter().find(|&&n| n == name) {
                 Some(&n) => v.push(n),
-                None => {
-                    return Err(format!(
-                        "unknown metric `{name}`; known metrics: {}",
-                        METRIC_NAMES.join(", ")
-                    ))
-                }
+                None => return Err(MeasureError::UnknownMetric(name.to_string())),
             }
         }
         if v.is_empty() {
-            return Err(format!("no metric named; known metrics: {}", METRIC_NAMES.join(", ")));
+            return Err(MeasureError::NoMetric);
         }
         Ok(Selection(v))
     }
@@ -210,11 +223,6 @@ pub fn measure_model(
     m
 }
 
-/// The model's sheet factors (for reports and for the stacking tests).
-pub fn factors(model: &dyn ComponentModel, q: &Quality) -> SheetFactors {
-    instrument::model_factors(model, q)
-}
-
 /// How much simulation [`measure_truth`] runs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TruthConfig {
@@ -267,8 +275,8 @@ pub fn measure_truth(
     grammage: Option<f64>,
     sel: &Selection,
     cfg: &TruthConfig,
-) -> Result<Measurements, String> {
-    let slab = Slab::from_params(p).map_err(|e| e.to_string())?;
+) -> Result<Measurements, MeasureError> {
+    let slab = Slab::from_params(p)?;
     let mut m = Measurements::empty("simulator");
     let pc = PadConfig {
         samples: cfg.pad_samples,
@@ -314,7 +322,7 @@ pub fn measure_truth(
             progress: cfg.progress,
             ..LateralConfig::default()
         };
-        let prof = simulate_exit_profile(&slab, DVec3::Z, &lc).map_err(|e| e.to_string())?;
+        let prof = simulate_exit_profile(&slab, DVec3::Z, &lc)?;
         m.scatter_distance_mm = edge::truth_edge(&prof).map(|e| ScatterDistance::of(&e));
     }
     Ok(m)
@@ -323,7 +331,7 @@ pub fn measure_truth(
 /// Gloss of the simulated sheet: `f` at the nominal source direction over a
 /// 5 x 5 Gauss-Legendre grid of the receptor window (the source aperture is
 /// not integrated: at the simulator's noise level it changes nothing).
-fn truth_gloss(slab: &Slab, p: &PaperParams, g: &gloss::GlossGeometry, cfg: &TruthConfig) -> Result<f64, String> {
+fn truth_gloss(slab: &Slab, p: &PaperParams, g: &gloss::GlossGeometry, cfg: &TruthConfig) -> Result<f64, SimError> {
     let theta = g.angle_deg.to_radians();
     let wi = DVec3::new(theta.sin(), 0.0, theta.cos());
     let (x, w) = paperbsdf_core::quadrature::gauss_legendre_01(5);
@@ -364,7 +372,7 @@ fn truth_gloss(slab: &Slab, p: &PaperParams, g: &gloss::GlossGeometry, cfg: &Tru
         progress: cfg.progress,
         ..SimConfig::default()
     };
-    let run = simulate_bsdf(slab, wi, &wos, &sc).map_err(|e| e.to_string())?;
+    let run = simulate_bsdf(slab, wi, &wos, &sc)?;
     let mut flux = Rgb::ZERO;
     for ((_, _, wt), (e, wo)) in pts.iter().zip(run.f.iter().zip(&wos)) {
         flux += e.mean * (wt * wo.z);
@@ -374,4 +382,23 @@ fn truth_gloss(slab: &Slab, p: &PaperParams, g: &gloss::GlossGeometry, cfg: &Tru
     }
     let glass = paperbsdf_core::fresnel::fresnel_dielectric(theta.cos(), g.glass_index);
     Ok(100.0 * luminance(flux) / glass)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn selection_errors_name_the_known_metrics() {
+        let known = METRIC_NAMES.join(", ");
+        let e = Selection::parse("r457, opacity").unwrap_err();
+        assert_eq!(e, MeasureError::UnknownMetric("opacity".into()));
+        assert_eq!(
+            e.to_string(),
+            format!("unknown metric `opacity`; known metrics: {known}")
+        );
+        let e = Selection::parse(" , ").unwrap_err();
+        assert_eq!(e.to_string(), format!("no metric named; known metrics: {known}"));
+        assert_eq!(Selection::parse("r457,gloss_75_tappi_t480").unwrap().0.len(), 2);
+    }
 }

@@ -5,7 +5,7 @@
 //! incident angles of [`DEFAULT_FIT_THETA_I`]; the other angles are
 //! extrapolation (grey panels). One figure per model, one row per paper.
 
-use crate::{draw_figure, panels_for, Figure, Row};
+use crate::{draw_figure, panels_for, Figure, PlotError, Row};
 use paperbsdf_fit::dataset::load_dataset;
 use paperbsdf_fit::models::candidates;
 use paperbsdf_fit::{fit, FitOptions, FitOutcome};
@@ -68,12 +68,23 @@ pub struct TableRow {
 /// The reference sets of `reference/` fitted beside the papers (if present).
 const REFERENCE_SETS: [&str; 2] = ["devA", "devB"];
 
-fn data_sets(dir: &Path) -> Result<Vec<(String, String, bool)>, String> {
+/// A data set or model that could not be set up: the fit crate's message,
+/// which names the file or the model.
+fn data_error(e: impl std::fmt::Display) -> PlotError {
+    PlotError::Data { message: e.to_string() }
+}
+
+/// The data sets of the figures: `(name, file, drawn in the figures)`, the
+/// bundled papers first (each must exist), then the reference sets present.
+fn data_sets(dir: &Path) -> Result<Vec<(String, String, bool)>, PlotError> {
     let mut v = Vec::new();
     for p in PAPERS {
         let f = dir.join(format!("{p}.csv"));
         if !f.exists() {
-            return Err(format!("{}: missing (the bundled {p} paper measurement)", f.display()));
+            return Err(PlotError::MissingData {
+                file: f.display().to_string(),
+                paper: p,
+            });
         }
         v.push((p.to_string(), f.display().to_string(), true));
     }
@@ -91,26 +102,33 @@ fn data_sets(dir: &Path) -> Result<Vec<(String, String, bool)>, String> {
 /// Fits every data set with every model, draws the three figures (PNG and SVG,
 /// linear value axis, plus a PNG with a log axis) and writes `fit_table.md`.
 /// Returns the table rows.
-pub fn make_figures(opts: &FiguresOptions) -> Result<Vec<TableRow>, String> {
+pub fn make_figures(opts: &FiguresOptions) -> Result<Vec<TableRow>, PlotError> {
     let sets = data_sets(&opts.data_dir)?;
-    std::fs::create_dir_all(&opts.out_dir).map_err(|e| format!("{}: {e}", opts.out_dir.display()))?;
+    std::fs::create_dir_all(&opts.out_dir).map_err(|source| PlotError::Io {
+        file: opts.out_dir.display().to_string(),
+        source,
+    })?;
     let mut table = Vec::new();
     for (num, model, stem, title) in FIGURES {
         let mut rows = Vec::new();
         for (name, path, in_figure) in &sets {
-            let ds = load_dataset(std::slice::from_ref(path), None)?;
+            let ds = load_dataset(std::slice::from_ref(path), None).map_err(data_error)?;
             let present: Vec<f64> = opts
                 .fit_theta_i
                 .iter()
                 .cloned()
                 .filter(|t| ds.points.iter().any(|p| (p.theta_i - t).abs() < 1e-6))
                 .collect();
-            let cands = candidates(model, ds.thickness, ds.channels == 3, None)?;
+            let cands = candidates(model, ds.thickness, ds.channels == 3, None).map_err(data_error)?;
             let fo = FitOptions {
                 fit_theta_i: Some(present.clone()),
                 ..opts.fit.clone()
             };
-            let out = fit(&ds.points, ds.channels, &cands, &fo).map_err(|e| format!("{name}, {model}: {e}"))?;
+            let out = fit(&ds.points, ds.channels, &cands, &fo).map_err(|e| PlotError::Fit {
+                data: name.clone(),
+                model,
+                message: e.to_string(),
+            })?;
             eprintln!(
                 "figure {num}: {name:>8} {model:>18}: rms {:.4}, extrapolation {:.4}, {:.2} s ({})",
                 out.rms_log_error,
@@ -119,7 +137,7 @@ pub fn make_figures(opts: &FiguresOptions) -> Result<Vec<TableRow>, String> {
                 out.variant
             );
             if *in_figure {
-                let m = cands[out.variant_index].build(&out.x)?;
+                let m = cands[out.variant_index].build(&out.x).map_err(data_error)?;
                 rows.push(Row {
                     label: name.clone(),
                     panels: panels_for(&ds.points, Some(m.as_ref()), Some(&present)),
@@ -134,16 +152,17 @@ pub fn make_figures(opts: &FiguresOptions) -> Result<Vec<TableRow>, String> {
         fig.layout = opts.layout;
         fig.panel_size = opts.panel_size;
         for ext in ["png", "svg", "pdf"] {
-            draw_figure(&fig, &opts.out_dir.join(format!("{stem}.{ext}"))).map_err(|e| e.to_string())?;
+            draw_figure(&fig, &opts.out_dir.join(format!("{stem}.{ext}")))?;
         }
         fig.log_y = true;
-        draw_figure(&fig, &opts.out_dir.join(format!("{stem}_log.png"))).map_err(|e| e.to_string())?;
+        draw_figure(&fig, &opts.out_dir.join(format!("{stem}_log.png")))?;
     }
     let md = table_markdown(&table, opts);
-    paperbsdf_io::write_atomic(opts.out_dir.join("fit_table.md"), md.as_bytes()).map_err(|e| e.to_string())?;
+    paperbsdf_io::write_atomic(opts.out_dir.join("fit_table.md"), md.as_bytes())?;
     Ok(table)
 }
 
+/// An optional error with four decimals, `-` when absent.
 fn fmt_opt(v: Option<f64>) -> String {
     v.map(|e| format!("{e:.4}")).unwrap_or_else(|| "-".into())
 }

@@ -189,3 +189,23 @@ fn writes_pdf() {
         "no temporary files left"
     );
 }
+
+#[test]
+fn figures_need_the_bundled_papers() {
+    let dir = tempfile::tempdir().unwrap();
+    let opts = figures::FiguresOptions {
+        layout: Layout::Grid,
+        panel_size: DEFAULT_PANEL_SIZE,
+        data_dir: dir.path().to_path_buf(),
+        out_dir: dir.path().join("out"),
+        fit_theta_i: figures::DEFAULT_FIT_THETA_I.to_vec(),
+        fit: Default::default(),
+    };
+    let e = figures::make_figures(&opts).unwrap_err();
+    assert!(matches!(e, PlotError::MissingData { paper: "matte", .. }), "{e:?}");
+    let want = format!(
+        "{}: missing (the bundled matte paper measurement)",
+        dir.path().join("matte.csv").display()
+    );
+    assert_eq!(e.to_string(), want);
+}

@@ -217,10 +217,26 @@ impl StochFace {
             TransportMode::Radiance => (1.0 / (c * c), c * c),
             TransportMode::Importance => (1.0, 1.0),
         };
-        // `up`: the propagation direction in the coating, heading for the top.
-        let mut up;
-        if w.z > 0.0 {
-            let (d, wt) = self.top_sample(w, mode, rnd)?;
+        // `at_top`: where light meets the top (pointing away from it), from
+        // outside (`w`) or from inside the coating after the first bounce.
+        let mut at_top = if w.z > 0.0 {
+            w
+        } else {
+            let (f, t) = planar(w, c);
+            if rnd() < f {
+                return Some(FaceSample {
+                    dir: DVec3::new(-w.x, -w.y, w.z),
+                    weight,
+                    delta: true,
+                });
+            }
+            let up = t?;
+            weight *= into_coat;
+            -up
+        };
+        // Light from outside meets the top once before its MAX_COAT_BOUNCES bounces.
+        for _ in 0..MAX_COAT_BOUNCES + u32::from(w.z > 0.0) {
+            let (d, wt) = self.top_sample(at_top, mode, rnd)?;
             weight *= wt;
             if d.z > 0.0 {
                 return Some(FaceSample {
@@ -232,34 +248,7 @@ impl StochFace {
             // Down through the coating to the coating/base interface.
             match self.at_planar_from_coat(d, into_base, &mut weight, rnd) {
                 Ok(done) => return Some(done),
-                Err(u) => up = u,
-            }
-        } else {
-            let (f, t) = planar(w, c);
-            if rnd() < f {
-                return Some(FaceSample {
-                    dir: DVec3::new(-w.x, -w.y, w.z),
-                    weight,
-                    delta: true,
-                });
-            }
-            up = t?;
-            weight *= into_coat;
-        }
-        for _ in 0..MAX_COAT_BOUNCES {
-            // At the top from inside the coating.
-            let (d, wt) = self.top_sample(-up, mode, rnd)?;
-            weight *= wt;
-            if d.z > 0.0 {
-                return Some(FaceSample {
-                    dir: d,
-                    weight,
-                    delta: false,
-                });
-            }
-            match self.at_planar_from_coat(d, into_base, &mut weight, rnd) {
-                Ok(done) => return Some(done),
-                Err(u) => up = u,
+                Err(up) => at_top = -up,
             }
         }
         None
