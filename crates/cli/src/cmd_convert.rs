@@ -2,9 +2,10 @@
 //! and writes the measurement CSV that `fit` and `plot` read
 //! (`kind,theta_i_deg,theta_o_deg,r,g,b`, reflection only; DESIGN.md section 2).
 
-use crate::cmd_eval::{check_angles, MAX_EVAL_ANGLES};
+use crate::cmd_eval::MAX_EVAL_ANGLES;
 use anyhow::{anyhow, bail, Result};
 use paperbsdf_fit::measured::{sample_in_plane, PointFilter};
+use paperbsdf_io::angles::check_angles;
 
 /// Arguments of `paperbsdf convert`.
 #[derive(clap::Args, Debug)]
@@ -31,8 +32,8 @@ pub struct ConvertArgs {
 /// Runs `paperbsdf convert`.
 pub fn run(a: ConvertArgs) -> Result<()> {
     let to = paperbsdf_io::angles::parse_angles(&a.theta_o, "--theta-o", MAX_EVAL_ANGLES)?;
-    check_angles(&a.theta_i, "--theta-i", 0.0, 89.999)?;
-    check_angles(&to, "--theta-o", -89.999, 89.999)?;
+    check_angles(&a.theta_i, "--theta-i", 0.0..=89.999)?;
+    check_angles(&to, "--theta-o", -89.999..=89.999)?;
     let filter = PointFilter {
         exclude_retro_deg: a.exclude_retro,
         max_theta_deg: a.max_theta,
@@ -53,12 +54,9 @@ pub fn run(a: ConvertArgs) -> Result<()> {
     if rows == 0 {
         bail!("every angle pair was left out by --exclude-retro / --max-theta: nothing to write");
     }
-    match &a.out {
-        Some(p) => {
-            paperbsdf_io::write_atomic(p, text.as_bytes())?;
-            eprintln!("wrote {p} ({rows} rows)");
-        }
-        None => print!("{text}"),
+    crate::emit(a.out.as_deref(), &text)?;
+    if let Some(p) = &a.out {
+        eprintln!("wrote {p} ({rows} rows)");
     }
     Ok(())
 }

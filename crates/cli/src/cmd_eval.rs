@@ -1,10 +1,13 @@
 //! `paperbsdf eval` and `paperbsdf albedo`: a model's BSDF values and directional
 //! albedo, in the conventions of DESIGN.md section 2.
 
+use crate::choices::{self, ComponentChoice};
 use anyhow::{bail, Result};
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::{DVec3, Rgb};
-use paperbsdf_io::models::{load_model, LoadedModel};
+use paperbsdf_io::angles::check_angles;
+use paperbsdf_io::dirs::csv_line;
+use paperbsdf_io::models::load_model;
 
 /// Arguments of `paperbsdf eval`.
 #[derive(clap::Args, Debug)]
@@ -24,9 +27,9 @@ pub struct EvalArgs {
     /// In-plane viewing angles: one angle, or FROM:TO:STEP, in degrees (signed; negative is opposite the light).
     #[arg(long = "theta-o", allow_hyphen_values = true)]
     pub theta_o: Option<String>,
-    /// Which component to evaluate: surface, single, multiple, direct or all.
-    #[arg(long, default_value = "all")]
-    pub component: String,
+    /// Which component to evaluate (a component the model lacks is an error).
+    #[arg(long, default_value = "all", value_parser = choices::component(), ignore_case = true)]
+    pub component: ComponentChoice,
     /// Write the table to this file (atomically) instead of standard output.
     #[arg(long)]
     pub out: Option<String>,
@@ -47,24 +50,23 @@ pub struct AlbedoArgs {
     /// Incident polar angles in degrees, comma-separated, in [0, 90).
     #[arg(long = "theta-i", value_delimiter = ',', required = true)]
     pub theta_i: Vec<f64>,
-    /// Which face the light arrives at: front (from z > 0) or back (from z < 0).
-    #[arg(long, default_value = "front")]
-    pub side: String,
+    /// Which face the light arrives at.
+    #[arg(long, value_enum, default_value_t = Side::Front, ignore_case = true)]
+    pub side: Side,
+}
+
+/// `albedo --side`: the face the light arrives at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Side {
+    /// The front face: light from z > 0.
+    Front,
+    /// The back face: light from z < 0.
+    Back,
 }
 
 /// Most angles `eval` accepts in `--theta-o` (evaluating is cheap; the limit
 /// bounds the output, 2 rows per angle and incident angle).
 pub const MAX_EVAL_ANGLES: usize = 100_000;
-
-/// Checks in-plane angles are within [lo, hi] degrees.
-pub fn check_angles(v: &[f64], what: &str, lo: f64, hi: f64) -> Result<()> {
-    for a in v {
-        if !(a.is_finite() && *a >= lo && *a <= hi) {
-            bail!("{what} = {a} is outside the allowed range [{lo}, {hi}] degrees");
-        }
-    }
-    Ok(())
-}
 
 /// BSDF values in the shortest decimal that reads back as the same f64
 /// (Rust's `{:e}`), so other front ends (the Python package) can be checked
@@ -93,33 +95,24 @@ fn value_header(rgb: bool) -> &'static str {
     }
 }
 
-fn emit(out: &Option<String>, text: String) -> Result<()> {
-    match out {
-        Some(p) => paperbsdf_io::write_atomic(p, text.as_bytes())?,
-        None => print!("{text}"),
-    }
-    Ok(())
-}
-
 /// Runs `paperbsdf eval`.
 pub fn run_eval(a: EvalArgs) -> Result<()> {
     if let Some(out) = &a.out {
         paperbsdf_io::check_output_path(out, "--out")?;
     }
     let model = load_model(&a.model, &a.params)?;
-    let component = a.component.as_str();
-    let eval =
-        |wi: DVec3, wo: DVec3| -> Result<Rgb> { model.eval_component(wi, wo, component).map_err(anyhow::Error::msg) };
-    // Validate the component name once, before any output.
-    eval(DVec3::Z, DVec3::Z)?;
+    let component = a.component.0;
+    // Before any output.
+    model.check_component(component)?;
+    let eval = |wi: DVec3, wo: DVec3| -> Result<Rgb> { Ok(model.eval_component(wi, wo, component)?) };
     let rgb = model.is_rgb();
     let mut text = String::new();
     if let Some(path) = &a.dirs {
         let f = paperbsdf_io::dirs::read_dirs(path)?;
-        text.push_str(&format!("{},{}\n", f.header.join(","), value_header(rgb)));
+        text.push_str(&format!("{},{}\n", csv_line(&f.header), value_header(rgb)));
         for r in &f.rows {
             let v = eval(r.wi, r.wo)?;
-            text.push_str(&format!("{},{}\n", r.fields.join(","), fmt_eval(v, rgb)));
+            text.push_str(&format!("{},{}\n", csv_line(&r.fields), fmt_eval(v, rgb)));
         }
     } else {
         let to = match &a.theta_o {
@@ -129,8 +122,8 @@ pub fn run_eval(a: EvalArgs) -> Result<()> {
         if a.theta_i.is_empty() {
             bail!("--theta-o needs --theta-i LIST (degrees)");
         }
-        check_angles(&a.theta_i, "--theta-i", 0.0, 90.0)?;
-        check_angles(&to, "--theta-o", -90.0, 90.0)?;
+        check_angles(&a.theta_i, "--theta-i", 0.0..=90.0)?;
+        check_angles(&to, "--theta-o", -90.0..=90.0)?;
         text.push_str(&format!("kind,theta_i_deg,theta_o_deg,{}\n", value_header(rgb)));
         for &ti in &a.theta_i {
             for (kind, t) in [("R", false), ("T", true)] {
@@ -142,23 +135,18 @@ pub fn run_eval(a: EvalArgs) -> Result<()> {
             }
         }
     }
-    emit(&a.out, text)
+    crate::emit(a.out.as_deref(), &text)
 }
 
 /// Runs `paperbsdf albedo`.
 pub fn run_albedo(a: AlbedoArgs) -> Result<()> {
     let model = load_model(&a.model, &a.params)?;
-    let sign = match a.side.as_str() {
-        "front" => 1.0,
-        "back" => -1.0,
-        s => bail!("--side `{s}`: expected `front` (light from z > 0) or `back` (light from z < 0)"),
+    let sign = match a.side {
+        Side::Front => 1.0,
+        Side::Back => -1.0,
     };
     // [0, 90), as the help says: at 90 degrees the light grazes the sheet and no flux enters.
-    for &t in &a.theta_i {
-        if !(t.is_finite() && (0.0..90.0).contains(&t)) {
-            bail!("--theta-i = {t} is outside the allowed range [0, 90) degrees");
-        }
-    }
+    check_angles(&a.theta_i, "--theta-i", 0.0..90.0)?;
     let rgb = model.is_rgb();
     let mut text = if rgb {
         "theta_i_deg,reflectance_r,reflectance_g,reflectance_b,transmittance_r,transmittance_g,transmittance_b\n"
@@ -175,6 +163,3 @@ pub fn run_albedo(a: AlbedoArgs) -> Result<()> {
     print!("{text}");
     Ok(())
 }
-
-#[allow(dead_code)]
-fn _assert_model_is_used(_: &LoadedModel) {}

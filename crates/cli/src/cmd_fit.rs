@@ -4,6 +4,7 @@
 //! [`paperbsdf_fit::measured`]), and writes FIT.json with the errors, what the
 //! data determine, and warnings.
 
+use crate::choices;
 use anyhow::{anyhow, bail, Result};
 use paperbsdf_core::{Distribution, FaceScattering};
 use paperbsdf_fit::dataset::load_dataset;
@@ -26,9 +27,9 @@ pub struct FitArgs {
     /// Incident angles (degrees, comma-separated) to fit; points at other angles are extrapolation points, scored separately. Default: all.
     #[arg(long = "fit-theta-i", value_delimiter = ',', allow_hyphen_values = true)]
     pub fit_theta_i: Vec<f64>,
-    /// Microfacet distributions to try per face (comma-separated: ggx, beckmann).
-    #[arg(long, value_delimiter = ',', default_value = "ggx,beckmann")]
-    pub dists: Vec<String>,
+    /// Microfacet distributions to try per face (comma-separated).
+    #[arg(long, value_delimiter = ',', default_value = "ggx,beckmann", value_parser = choices::distribution(), ignore_case = true)]
+    pub dists: Vec<Distribution>,
     /// Write the fit (model, params, errors, seconds) to this JSON file (atomically).
     #[arg(long)]
     pub out: Option<String>,
@@ -46,7 +47,7 @@ pub struct FitArgs {
     pub seed: u64,
     /// Faces of the paper and reduced-multilayer models: `multiple` (energy-conserving, the default) or
     /// `single` (Walter's single-scattering faces, as in the paper and Mitsuba's roughdielectric).
-    #[arg(long = "face-scattering", default_value = "multiple", value_parser = parse_face_scattering)]
+    #[arg(long = "face-scattering", default_value = "multiple", value_parser = choices::face_scattering(), ignore_case = true)]
     pub face_scattering: FaceScattering,
     /// Hold a parameter at a value (repeatable): e.g. `--fix eta_f=1.5 --fix m_b=0.4`; a colour parameter's name fixes all its channels.
     #[arg(long = "fix", value_name = "NAME=VALUE")]
@@ -68,20 +69,6 @@ fn rms_over(model: &dyn paperbsdf_fit::Evaluable, pts: &[&Point], channels: usiz
     paperbsdf_fit::objective::rms_log_error(model, pts, channels).map(|e| e.0)
 }
 
-fn parse_face_scattering(s: &str) -> Result<FaceScattering, String> {
-    s.parse::<FaceScattering>().map_err(|e| e.to_string())
-}
-
-/// Parses a list of distribution names.
-pub fn parse_dists(v: &[String]) -> Result<Vec<Distribution>> {
-    v.iter()
-        .map(|s| {
-            Distribution::parse(s)
-                .ok_or_else(|| anyhow!("--dists: unknown distribution `{s}` (expected ggx or beckmann)"))
-        })
-        .collect()
-}
-
 /// Runs `paperbsdf fit`.
 pub fn run(args: FitArgs) -> Result<()> {
     if args.samples == 0 || args.starts == 0 || args.max_iter == 0 {
@@ -91,7 +78,6 @@ pub fn run(args: FitArgs) -> Result<()> {
         // Before the fit, not after it (issue 16).
         paperbsdf_io::check_output_path(out, "--out")?;
     }
-    let dists = parse_dists(&args.dists)?;
     let filter = PointFilter {
         exclude_retro_deg: args.exclude_retro,
         max_theta_deg: args.max_theta,
@@ -174,7 +160,7 @@ pub fn run(args: FitArgs) -> Result<()> {
         &args.model,
         ds.thickness,
         ds.channels == 3,
-        Some(&dists),
+        Some(&args.dists),
         args.face_scattering,
     )
     .map_err(|e| anyhow!(e))?;

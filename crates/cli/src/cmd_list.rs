@@ -9,9 +9,20 @@ use paperbsdf_core::presets::{preset, PRESET_NAMES};
 /// Arguments of `paperbsdf list`.
 #[derive(clap::Args, Debug)]
 pub struct ListArgs {
-    /// What to list: models, presets or all.
-    #[arg(default_value = "all")]
-    pub what: String,
+    /// What to list.
+    #[arg(value_enum, default_value_t = What::All, ignore_case = true)]
+    pub what: What,
+}
+
+/// What `paperbsdf list` prints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum What {
+    /// The models with their parameters.
+    Models,
+    /// The paper presets with their values.
+    Presets,
+    /// Both.
+    All,
 }
 
 /// The parameters of the Paper BSDF: name, range, meaning (DESIGN.md section 3).
@@ -36,12 +47,9 @@ pub const PAPER_PARAMS: [(&str, &str, &str); 13] = [
 ];
 
 /// The text `paperbsdf list WHAT` prints.
-pub fn listing(what: &str) -> Result<String> {
-    let models = what == "all" || what == "models";
-    let presets = what == "all" || what == "presets";
-    if !models && !presets {
-        anyhow::bail!("list `{what}`: expected models, presets or all");
-    }
+pub fn listing(what: What) -> Result<String> {
+    let models = what != What::Presets;
+    let presets = what != What::Models;
     let mut s = String::new();
     if models {
         s.push_str(
@@ -94,6 +102,6 @@ pub fn listing(what: &str) -> Result<String> {
 
 /// Runs `paperbsdf list`.
 pub fn run(a: ListArgs) -> Result<()> {
-    print!("{}", listing(&a.what)?);
+    print!("{}", listing(a.what)?);
     Ok(())
 }

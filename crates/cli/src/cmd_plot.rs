@@ -7,13 +7,14 @@
 //! `--theta-i` and `--theta-o`, sampled in memory exactly as `paperbsdf
 //! convert` samples them ([`paperbsdf_fit::measured::sample_in_plane`]).
 
-use crate::cmd_eval::{check_angles, MAX_EVAL_ANGLES};
+use crate::cmd_eval::MAX_EVAL_ANGLES;
 use crate::cmd_fit::is_bsdf_file;
 use anyhow::{anyhow, bail, Result};
 use paperbsdf_fit::dataset::{load_dataset, Dataset};
 use paperbsdf_fit::measured::{sample_in_plane, PointFilter, Sampling};
 use paperbsdf_fit::models::build_from_params;
 use paperbsdf_fit::FitOptions;
+use paperbsdf_io::angles::check_angles;
 use paperbsdf_plot::figures::{make_figures, FiguresOptions, DEFAULT_FIT_THETA_I};
 use paperbsdf_plot::{draw_figure, panels_for, Figure, Layout, Row};
 use std::path::PathBuf;
@@ -31,9 +32,9 @@ pub struct PlotArgs {
     /// current directory); with --figures, the output directory (default docs).
     #[arg(long)]
     pub out: Option<String>,
-    /// Panel layout: grid (per paper, BRDF panels over BTDF panels, one column per incident angle) or row (all in one row).
-    #[arg(long, default_value = "grid")]
-    pub layout: String,
+    /// Panel layout.
+    #[arg(long, value_enum, default_value_t = LayoutChoice::Grid, ignore_case = true)]
+    pub layout: LayoutChoice,
     /// Size of one panel, WIDTHxHEIGHT in pixels (PNG) or points (SVG, PDF).
     #[arg(long = "panel-size", default_value = "300x220")]
     pub panel_size: String,
@@ -68,6 +69,24 @@ pub struct PlotArgs {
     /// Leave out points whose light or viewer is more than DEG degrees from the normal.
     #[arg(long = "max-theta", value_name = "DEG")]
     pub max_theta: Option<f64>,
+}
+
+/// `plot --layout`: the choices of [`Layout`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum LayoutChoice {
+    /// Per paper, BRDF panels over BTDF panels, one column per incident angle.
+    Grid,
+    /// All panels in one row.
+    Row,
+}
+
+impl From<LayoutChoice> for Layout {
+    fn from(c: LayoutChoice) -> Layout {
+        match c {
+            LayoutChoice::Grid => Layout::Grid,
+            LayoutChoice::Row => Layout::Row,
+        }
+    }
 }
 
 /// The in-plane slices of a measured `.bsdf` file at `theta_i` x `theta_o` that `filter` keeps,
@@ -135,8 +154,7 @@ pub fn parse_panel_size(s: &str) -> Result<(u32, u32)> {
 
 /// Runs `paperbsdf plot`.
 pub fn run(args: PlotArgs) -> Result<()> {
-    let layout =
-        Layout::parse(&args.layout).ok_or_else(|| anyhow!("--layout `{}`: expected grid or row", args.layout))?;
+    let layout = Layout::from(args.layout);
     let panel_size = parse_panel_size(&args.panel_size)?;
     if args.figures {
         if !args.data.is_empty() || !args.fit.is_empty() {
@@ -211,8 +229,8 @@ pub fn run(args: PlotArgs) -> Result<()> {
             "--theta-o",
             MAX_EVAL_ANGLES,
         )?;
-        check_angles(&ti, "--theta-i", 0.0, 89.999)?;
-        check_angles(&to, "--theta-o", -89.999, 89.999)?;
+        check_angles(&ti, "--theta-i", 0.0..=89.999)?;
+        check_angles(&to, "--theta-o", -89.999..=89.999)?;
         (ti, to)
     } else {
         if !args.theta_i.is_empty() || args.theta_o.is_some() {

@@ -6,8 +6,10 @@
 
 use anyhow::{bail, Context, Result};
 use paperbsdf_core::geometry::in_plane_directions;
-use paperbsdf_core::{PaperParams, Rgb};
-use paperbsdf_sim::{simulate_bsdf, simulate_totals, Estimate, Incidence, SimConfig, Slab};
+use paperbsdf_core::{DVec3, PaperParams, Rgb};
+use paperbsdf_io::angles::check_angles;
+use paperbsdf_sim::{simulate_bsdf, simulate_totals, Estimate, Incidence, SimConfig, Slab, Totals};
+use std::ops::Bound::Excluded;
 
 /// Arguments of `paperbsdf simulate`.
 #[derive(clap::Args, Debug)]
@@ -78,18 +80,6 @@ fn load(source: &str) -> Result<PaperParams> {
     Ok(l.value)
 }
 
-/// Checks that every angle is finite and within `(lo, hi)` (open) or `[lo, hi)`.
-fn check_angles(v: &[f64], what: &str, lo: f64, lo_inclusive: bool, hi: f64) -> Result<()> {
-    for &a in v {
-        let above = if lo_inclusive { a >= lo } else { a > lo };
-        if !(a.is_finite() && above && a < hi) {
-            let open = if lo_inclusive { '[' } else { '(' };
-            bail!("{what} = {a} is outside the allowed range {open}{lo}, {hi}) degrees");
-        }
-    }
-    Ok(())
-}
-
 fn config(a: &SimulateArgs) -> Result<SimConfig> {
     if let Some(x) = a.rel_stderr {
         if !(x > 0.0 && x < 1.0) {
@@ -135,18 +125,19 @@ fn config(a: &SimulateArgs) -> Result<SimConfig> {
     })
 }
 
-/// Refuses a run predicted to take more than `--max-collisions` collisions,
-/// with the reason and the estimated time (from a short pilot of walks).
+/// Refuses a run predicted to take more than `max_collisions` collisions
+/// (`--max-collisions`), with the reason and the estimated time (from a short
+/// pilot of walks).
 fn check_work(
-    a: &SimConfigArgs,
+    max_collisions: f64,
     slab: &Slab,
     cfg: &SimConfig,
-    wi: paperbsdf_core::DVec3,
-    wos: &[paperbsdf_core::DVec3],
+    wi: DVec3,
+    wos: &[DVec3],
     n_dirs: usize,
 ) -> Result<()> {
     let w = paperbsdf_sim::estimate::estimate_work(slab, cfg, n_dirs);
-    if w.collisions <= a.max_collisions {
+    if w.collisions <= max_collisions {
         return Ok(());
     }
     let rate = paperbsdf_sim::estimate::measure_collision_rate(slab, wi, wos, 0.3);
@@ -167,7 +158,7 @@ lower --samples or raise --max-collisions to run anyway",
         w.collisions_per_walk,
         human_time(w.collisions / rate),
         rate,
-        a.max_collisions,
+        max_collisions,
         m.sigma_t * slab.d,
         m.albedo
     )
@@ -184,11 +175,6 @@ fn human_time(s: f64) -> String {
     } else {
         format!("{:.1e} days", s / 86400.0)
     }
-}
-
-/// What the options of a run allow beyond the [`SimConfig`].
-struct SimConfigArgs {
-    max_collisions: f64,
 }
 
 /// Notes on a run for the end of the output: achieved precision, walks cut.
@@ -227,6 +213,34 @@ their remaining flux (at most {:.3e} of the incident flux) is missing from these
         eprintln!("warning: {}", m.trim_start_matches("WARNING "));
         notes.push(m);
     }
+}
+
+/// One row of the totals table, `label,` then reflectance and transmittance;
+/// the notes on the run (`what`) go to `notes`.
+fn totals_row(label: &str, what: &str, t: &Totals, cfg: &SimConfig, rgb: bool, notes: &mut Vec<String>) -> String {
+    run_notes(
+        what,
+        cfg,
+        t.samples,
+        t.truncated,
+        t.worst_rel_stderr,
+        t.target_reached,
+        notes,
+    );
+    format!(
+        "{label},{},{}\n",
+        fmt_estimate(&t.reflectance, rgb),
+        fmt_estimate(&t.transmittance, rgb)
+    )
+}
+
+/// The in-plane viewing directions at incidence `ti` and angles `to`: the
+/// `R` rows, then the `T` rows (the order of the table and of [`simulate_bsdf`]'s values).
+fn view_dirs(ti: f64, to: &[f64]) -> Vec<DVec3> {
+    [false, true]
+        .iter()
+        .flat_map(|&t| to.iter().map(move |&o| in_plane_directions(ti, o, t).1))
+        .collect()
 }
 
 fn fmt(v: f64) -> String {
@@ -274,9 +288,6 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     let slab = Slab::from_params(&p).with_context(|| format!("parameters `{}`", a.params))?;
     paperbsdf_sim::estimate::check_slab(&slab).with_context(|| format!("parameters `{}`", a.params))?;
     let cfg = config(&a)?;
-    let limits = SimConfigArgs {
-        max_collisions: a.max_collisions,
-    };
     let rgb = slab.rgb;
     let mut text = header_line(&p, &cfg);
     let mut notes = Vec::new();
@@ -288,47 +299,22 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         };
         if a.diffuse {
             text.push_str(&format!("incidence,{cols}\n"));
-            check_work(&limits, &slab, &cfg, paperbsdf_core::DVec3::Z, &[], 1)?;
+            check_work(a.max_collisions, &slab, &cfg, DVec3::Z, &[], 1)?;
             let t = simulate_totals(&slab, Incidence::Diffuse { front: true }, &cfg)?;
-            run_notes(
-                "diffuse",
-                &cfg,
-                t.samples,
-                t.truncated,
-                t.worst_rel_stderr,
-                t.target_reached,
-                &mut notes,
-            );
-            text.push_str(&format!(
-                "diffuse,{},{}\n",
-                fmt_estimate(&t.reflectance, rgb),
-                fmt_estimate(&t.transmittance, rgb)
-            ));
+            text.push_str(&totals_row("diffuse", "diffuse", &t, &cfg, rgb, &mut notes));
         } else {
             if a.theta_i.is_empty() {
                 bail!("--totals needs --theta-i LIST (degrees) or --diffuse");
             }
-            check_angles(&a.theta_i, "--theta-i", 0.0, true, 90.0)?;
+            check_angles(&a.theta_i, "--theta-i", 0.0..90.0)?;
             text.push_str(&format!("theta_i_deg,{cols}\n"));
             let (wi0, _) = in_plane_directions(a.theta_i[0], 0.0, false);
-            check_work(&limits, &slab, &cfg, wi0, &[], a.theta_i.len())?;
+            check_work(a.max_collisions, &slab, &cfg, wi0, &[], a.theta_i.len())?;
             for &ti in &a.theta_i {
                 let (wi, _) = in_plane_directions(ti, 0.0, false);
                 let t = simulate_totals(&slab, Incidence::Collimated(wi), &cfg)?;
-                run_notes(
-                    &format!("theta_i {ti}"),
-                    &cfg,
-                    t.samples,
-                    t.truncated,
-                    t.worst_rel_stderr,
-                    t.target_reached,
-                    &mut notes,
-                );
-                text.push_str(&format!(
-                    "{ti},{},{}\n",
-                    fmt_estimate(&t.reflectance, rgb),
-                    fmt_estimate(&t.transmittance, rgb)
-                ));
+                let what = format!("theta_i {ti}");
+                text.push_str(&totals_row(&ti.to_string(), &what, &t, &cfg, rgb, &mut notes));
             }
         }
     } else {
@@ -339,23 +325,11 @@ pub fn run(a: SimulateArgs) -> Result<()> {
             bail!("--theta-o needs --theta-i LIST (degrees)");
         }
         let to = paperbsdf_io::angles::parse_angles(range, "--theta-o", MAX_VIEW_ANGLES)?;
-        check_angles(&a.theta_i, "--theta-i", 0.0, true, 90.0)?;
-        check_angles(&to, "--theta-o", -90.0, false, 90.0)?;
-        {
-            let ti = a.theta_i[0];
-            let wos: Vec<_> = [false, true]
-                .iter()
-                .flat_map(|&t| to.iter().map(move |&o| in_plane_directions(ti, o, t).1))
-                .collect();
-            check_work(
-                &limits,
-                &slab,
-                &cfg,
-                in_plane_directions(ti, 0.0, false).0,
-                &wos,
-                a.theta_i.len(),
-            )?;
-        }
+        check_angles(&a.theta_i, "--theta-i", 0.0..90.0)?;
+        check_angles(&to, "--theta-o", (Excluded(-90.0), Excluded(90.0)))?;
+        let ti = a.theta_i[0];
+        let (wi0, _) = in_plane_directions(ti, 0.0, false);
+        check_work(a.max_collisions, &slab, &cfg, wi0, &view_dirs(ti, &to), a.theta_i.len())?;
         let cols = if rgb {
             "r,g,b,r_stderr,g_stderr,b_stderr"
         } else {
@@ -364,14 +338,8 @@ pub fn run(a: SimulateArgs) -> Result<()> {
         text.push_str(&format!("kind,theta_i_deg,theta_o_deg,{cols}\n"));
         for &ti in &a.theta_i {
             // One set of walks per incident angle serves every viewing direction, R and T.
-            let mut wos = Vec::with_capacity(2 * to.len());
-            for t in [false, true] {
-                for &o in &to {
-                    wos.push(in_plane_directions(ti, o, t).1);
-                }
-            }
             let (wi, _) = in_plane_directions(ti, 0.0, false);
-            let run = simulate_bsdf(&slab, wi, &wos, &cfg)?;
+            let run = simulate_bsdf(&slab, wi, &view_dirs(ti, &to), &cfg)?;
             run_notes(
                 &format!("theta_i {ti}"),
                 &cfg,
@@ -394,11 +362,7 @@ pub fn run(a: SimulateArgs) -> Result<()> {
     for n in &notes {
         text.push_str(&format!("# {n}\n"));
     }
-    match &a.out {
-        Some(path) => paperbsdf_io::write_atomic(path, text.as_bytes())?,
-        None => print!("{text}"),
-    }
-    Ok(())
+    crate::emit(a.out.as_deref(), &text)
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@
 
 use clap::{Parser, Subcommand};
 
+mod choices;
 mod cmd_convert;
 mod cmd_eval;
 mod cmd_fit;
@@ -83,6 +84,16 @@ impl std::error::Error for Interrupted {}
 
 /// Exit code of a run stopped by SIGINT (128 + 2, as shells report it).
 pub const EXIT_INTERRUPTED: i32 = 130;
+
+/// Writes a command's output `text` to the file `out` (atomically) or, without
+/// one, to standard output.
+pub fn emit(out: Option<&str>, text: &str) -> anyhow::Result<()> {
+    match out {
+        Some(p) => paperbsdf_io::write_atomic(p, text.as_bytes())?,
+        None => print!("{text}"),
+    }
+    Ok(())
+}
 
 /// The lines printed for an error: the message, then each cause not already shown.
 fn error_lines(e: &anyhow::Error) -> Vec<String> {

@@ -1,27 +1,12 @@
 //! `paperbsdf eval` and `paperbsdf albedo` end to end: output format, conventions
 //! and the errors for bad input (which must name file, line and field, never panic).
 
-use std::process::Command;
-
+// The reference data's location, shared with the io crate's tests.
+#[path = "../../io/tests/common/mod.rs"]
 mod common;
+mod support;
 
-fn run(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_paperbsdf"))
-        .args(args)
-        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
-
-fn assert_clean_error(stderr: &str) {
-    assert!(stderr.starts_with("error: "), "{stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-}
+use support::{assert_clean_error, run};
 
 #[test]
 fn eval_dirs_appends_f_and_matches_library() {
@@ -160,7 +145,7 @@ fn bad_inputs_are_clear_errors() {
         let a: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
         let (ok, _, err) = run(&a);
         assert!(!ok);
-        assert_clean_error(&err);
+        assert_clean_error(&err, &[]);
         for n in needles {
             assert!(err.contains(n), "expected `{n}` in: {err}");
         }
@@ -188,7 +173,7 @@ fn bad_inputs_are_clear_errors() {
         let f = p("f.csv", text);
         let (ok, _, err) = run(&["eval", "--model", "rough-dielectric", "--params", params, "--dirs", &f]);
         assert!(!ok);
-        assert_clean_error(&err);
+        assert_clean_error(&err, &[]);
         for n in needles {
             assert!(err.contains(n), "expected `{n}` in: {err}");
         }
@@ -248,7 +233,8 @@ fn bad_inputs_are_clear_errors() {
                 "--component",
                 "foo",
             ],
-            "unknown component `foo`",
+            // clap's message: the flag and the allowed values
+            "invalid value 'foo' for '--component <COMPONENT>'\n  [possible values: surface, single, multiple, direct, all]",
         ),
         (
             vec![
@@ -262,12 +248,12 @@ fn bad_inputs_are_clear_errors() {
                 "--side",
                 "top",
             ],
-            "--side `top`",
+            "invalid value 'top' for '--side <SIDE>'\n  [possible values: front, back]",
         ),
     ] {
         let (ok, _, err) = run(&args);
         assert!(!ok);
-        assert_clean_error(&err);
+        assert_clean_error(&err, &[]);
         assert!(err.contains(needle), "expected `{needle}` in: {err}");
     }
 }

@@ -1,25 +1,12 @@
 //! `paperbsdf measure`, `edge` and `from-datasheet` end to end: JSON keys,
 //! the round trip through a parameter file, and clear errors for bad input.
 
-use std::process::Command;
+mod support;
 
-fn run(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_paperbsdf"))
-        .args(args)
-        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
+use support::run;
 
 fn assert_clean_error(stderr: &str, needle: &str) {
-    assert!(stderr.starts_with("error: "), "{stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    assert!(stderr.contains(needle), "expected `{needle}` in: {stderr}");
+    support::assert_clean_error(stderr, &[needle]);
 }
 
 #[test]

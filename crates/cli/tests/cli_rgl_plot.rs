@@ -3,34 +3,12 @@
 //! curves of a fit to it, grey where extrapolated; and clean errors for bad
 //! `.bsdf` files and misplaced options.
 
+mod support;
+
 use std::path::Path;
-use std::process::{Command, Output};
+use support::{fails_with, output as run, text, ROOT};
 
-const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 const SATIN: &str = "data/reference/rgl/satin_rosaline_rgb.bsdf";
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_paperbsdf"))
-        .args(args)
-        .current_dir(ROOT)
-        .output()
-        .unwrap()
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-/// Fails with exit code 2 and one clean error whose text contains every part.
-fn fails_with(args: &[&str], parts: &[&str]) {
-    let o = run(args);
-    let err = text(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-    assert!(err.starts_with("error: ") && !err.contains("panicked"), "{err}");
-    for p in parts {
-        assert!(err.contains(p), "`{p}` not in: {err}");
-    }
-}
 
 /// A quick (not converged) fit of the Lambert + rough glass model to the satin file.
 fn quick_fit(dir: &Path) -> String {

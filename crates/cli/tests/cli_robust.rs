@@ -1,37 +1,15 @@
 //! Issue 16, end to end: bad or extreme input never hangs, crashes or quietly
 //! gives a wrong answer. Each test is one case of the issue.
 
-use std::path::Path;
-use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
+mod support;
 
-const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+use support::{fails_with, output as run, text, ROOT};
+
 const P: &str = r#"{"d":0.05,"sigma_a":0.5,"sigma_s":40,"g_f":0.8,"g_b":-0.3,"w_b":0.2,"eta_f":1.5,"eta_b":1.5,"m_f":0.3,"m_b":0.3,"dist_f":"ggx","dist_b":"beckmann"}"#;
 const GLASS: &str = r#"{"eta":1.5,"m":0.3,"dist":"ggx"}"#;
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_paperbsdf"))
-        .args(args)
-        .current_dir(ROOT)
-        .output()
-        .unwrap()
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-/// Fails with exit code 2 and one clean error whose text contains every part.
-fn fails_with(args: &[&str], parts: &[&str]) -> String {
-    let o = run(args);
-    let err = text(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-    assert!(err.starts_with("error: ") && !err.contains("panicked"), "{err}");
-    for p in parts {
-        assert!(err.contains(p), "`{p}` not in: {err}");
-    }
-    err
-}
 
 fn sim(extra: &[&str]) -> Vec<String> {
     let mut v: Vec<String> = ["simulate", "--params", P].iter().map(|s| s.to_string()).collect();

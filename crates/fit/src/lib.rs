@@ -3,8 +3,8 @@
 //! Fitting BSDF models to in-plane (or general) BSDF measurements, as in
 //! sections 5 to 7 of the Paper BSDF supplement and DESIGN.md section 5:
 //!
-//! * [`measurement`]: readers for measurement files, with errors that name the
-//!   file, line and column;
+//! * [`measurement`]: the measurement files' reader of [`paperbsdf_io::measurement`],
+//!   re-exported (errors name the file, line and column);
 //! * [`model`]: what the fitter needs of a model ([`model::FitModel`]);
 //! * [`models`]: the Paper BSDF and the comparison models as fit models;
 //! * [`objective`]: the log-space RMS error and its weighting;

@@ -3,7 +3,10 @@
 //!
 //! Grid angles are `FROM + k * STEP` rounded to [`ANGLE_DECIMALS`] decimals, so
 //! `0:1:0.1` gives `0.3`, not `0.30000000000000004`: the rounded value is the
-//! one used and printed. Errors quote the text as given.
+//! one used and printed. Errors quote the text as given. [`check_angles`]
+//! checks angles against an allowed range.
+
+use std::ops::{Bound, RangeBounds};
 
 /// Decimals grid angles are rounded to (far below any measurement's precision).
 pub const ANGLE_DECIMALS: i32 = 9;
@@ -82,9 +85,46 @@ pub fn parse_angles(s: &str, what: &str, max_count: usize) -> Result<Vec<f64>, A
     }
 }
 
+/// Checks that every angle of `v` is finite and within `range` (degrees; any
+/// mix of open and closed ends, e.g. `0.0..90.0` for `[0, 90)`); the error
+/// names the option `what`, the value and the range:
+/// `--theta-i = 95 is outside the allowed range [0, 90) degrees`.
+pub fn check_angles(v: &[f64], what: &str, range: impl RangeBounds<f64>) -> Result<(), AngleError> {
+    let Some(bad) = v.iter().find(|a| !(a.is_finite() && range.contains(a))) else {
+        return Ok(());
+    };
+    let (open, lo) = match range.start_bound() {
+        Bound::Included(x) => ('[', x.to_string()),
+        Bound::Excluded(x) => ('(', x.to_string()),
+        Bound::Unbounded => ('(', "-inf".into()),
+    };
+    let (hi, close) = match range.end_bound() {
+        Bound::Included(x) => (x.to_string(), ']'),
+        Bound::Excluded(x) => (x.to_string(), ')'),
+        Bound::Unbounded => ("inf".into(), ')'),
+    };
+    Err(AngleError(format!(
+        "{what} = {bad} is outside the allowed range {open}{lo}, {hi}{close} degrees"
+    )))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[test]
+    fn ranges_open_and_closed() {
+        assert!(check_angles(&[0.0, 90.0], "x", 0.0..=90.0).is_ok());
+        let e = check_angles(&[30.0, 95.0], "--theta-i", 0.0..90.0).unwrap_err().0;
+        assert_eq!(e, "--theta-i = 95 is outside the allowed range [0, 90) degrees");
+        let open = (Bound::Excluded(-90.0), Bound::Excluded(90.0));
+        let e = check_angles(&[-90.0], "--theta-o", open).unwrap_err().0;
+        assert_eq!(e, "--theta-o = -90 is outside the allowed range (-90, 90) degrees");
+        let e = check_angles(&[f64::NAN], "--theta-o", -89.999..=89.999).unwrap_err().0;
+        assert_eq!(
+            e,
+            "--theta-o = NaN is outside the allowed range [-89.999, 89.999] degrees"
+        );
+    }
     #[test]
     fn single_angle_and_clean_grid() {
         // Issue 17 item 7: `--theta-o 0` was rejected.

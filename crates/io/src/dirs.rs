@@ -1,6 +1,7 @@
 //! CSV files of direction pairs: columns `wi_x,wi_y,wi_z,wo_x,wo_y,wo_z` (any
-//! order, other columns ignored, `#` lines are comments), in the local frame
-//! of DESIGN.md section 2. Each direction must be finite and of unit length
+//! order, other columns ignored, `#` lines are comments; read with the `csv`
+//! crate, see [`crate::text::csv_records`]), in the local frame of DESIGN.md
+//! section 2. Each direction must be finite and of unit length
 //! (to 1e-4); an error names the file, line and field.
 
 use crate::DataError;
@@ -11,7 +12,7 @@ use paperbsdf_core::DVec3;
 pub struct DirRow {
     /// 1-based line in the file.
     pub line: usize,
-    /// The row's fields as written (for echoing the row back).
+    /// The row's fields as written, trimmed and unquoted (echo them with [`csv_line`]).
     pub fields: Vec<String>,
     /// Direction toward the light (normalised).
     pub wi: DVec3,
@@ -47,13 +48,9 @@ pub fn parse_dirs(text: &str, origin: &str) -> Result<DirFile, DataError> {
         field: field.to_string(),
         message,
     };
-    let mut lines = crate::text::strip_bom(text)
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let header: Vec<String> = match lines.next() {
-        Some((_, l)) => l.split(',').map(|s| s.trim().to_string()).collect(),
+    let mut records = crate::text::csv_records(crate::text::strip_bom(text), origin);
+    let header: Vec<String> = match records.next().transpose()? {
+        Some(r) => r.fields.iter().map(str::to_string).collect(),
         None => {
             return Err(DataError::Other {
                 file: origin.to_string(),
@@ -69,19 +66,20 @@ pub fn parse_dirs(text: &str, origin: &str) -> Result<DirFile, DataError> {
         })?;
     }
     let mut rows = Vec::new();
-    for (line, l) in lines {
-        let rec: Vec<String> = l.split(',').map(|s| s.trim().to_string()).collect();
-        if rec.len() != header.len() {
+    for r in records {
+        let r = r?;
+        let line = r.line;
+        if r.fields.len() != header.len() {
             return Err(DataError::Syntax {
                 file: origin.to_string(),
                 line,
                 column: 0,
-                message: format!("{} fields, but the header has {}", rec.len(), header.len()),
+                message: format!("{} fields, but the header has {}", r.fields.len(), header.len()),
             });
         }
         let mut v = [0.0f64; 6];
         for k in 0..6 {
-            let s = &rec[idx[k]];
+            let s = &r.fields[idx[k]];
             v[k] = s
                 .parse::<f64>()
                 .map_err(|_| err(line, COLS[k], format!("`{s}` is not a number")))?;
@@ -103,12 +101,25 @@ pub fn parse_dirs(text: &str, origin: &str) -> Result<DirFile, DataError> {
         }
         rows.push(DirRow {
             line,
-            fields: rec,
+            fields: r.fields.iter().map(str::to_string).collect(),
             wi: wi.normalize(),
             wo: wo.normalize(),
         });
     }
     Ok(DirFile { header, rows })
+}
+
+/// `fields` as one CSV line: a field holding a comma, a quote or a line break
+/// is quoted (`"` doubled), so a row read with quoted fields is echoed intact.
+pub fn csv_line(fields: &[String]) -> String {
+    let quoted = fields.iter().map(|f| {
+        if f.contains([',', '"', '\n', '\r']) {
+            format!("\"{}\"", f.replace('"', "\"\""))
+        } else {
+            f.clone()
+        }
+    });
+    quoted.collect::<Vec<_>>().join(",")
 }
 
 #[cfg(test)]
@@ -139,6 +150,17 @@ mod tests {
         let e = parse_dirs("a,b\n1,2\n", "y.csv").unwrap_err().to_string();
         assert!(e.contains("missing column `wi_x`"), "{e}");
         assert!(parse_dirs("", "z.csv").is_err());
+        let e = parse_dirs("wi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n\n0,0,1,1,0\n", "x.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("x.csv:3:0: 5 fields"), "{e}");
+    }
+    #[test]
+    fn quoted_fields_are_read_and_echoed() {
+        let t = "label,wi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n\"a, \"\"b\"\"\",0,0,1,1,0,0\n";
+        let f = parse_dirs(t, "q.csv").unwrap();
+        assert_eq!(f.rows[0].fields[0], "a, \"b\"");
+        assert_eq!(csv_line(&f.rows[0].fields), "\"a, \"\"b\"\"\",0,0,1,1,0,0");
     }
     #[test]
     fn byte_order_mark_is_ignored() {
@@ -149,5 +171,7 @@ mod tests {
         assert_eq!(f.rows.len(), 1);
         let t = "\u{feff}# comment first\nwi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n0,0,1,1,0,0\n";
         assert_eq!(parse_dirs(t, "bom.csv").unwrap().rows[0].line, 3);
+        // Only one mark is a byte-order mark (the csv reader must not drop a second).
+        assert!(parse_dirs("\u{feff}\u{feff}wi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n", "bom.csv").is_err());
     }
 }

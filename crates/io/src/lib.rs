@@ -2,8 +2,10 @@
 //!
 //! Reading and writing the project's files in the conventions of DESIGN.md:
 //! parameter files (JSON, TOML or inline JSON) with errors that name the file,
-//! line and parameter; CSV files of direction pairs; atomic output (a temp file
-//! renamed into place, so a failed run leaves no half-written result).
+//! line and parameter; CSV files of direction pairs and of BSDF measurements
+//! ([`measurement`]), with errors that name the file, line and column; atomic
+//! output (a temp file renamed into place, so a failed run leaves no
+//! half-written result).
 
 #![warn(missing_docs)]
 
@@ -11,6 +13,7 @@ pub mod angles;
 pub mod atomic;
 pub mod dirs;
 pub mod error;
+pub mod measurement;
 pub mod models;
 pub mod params;
 pub mod rgl;

@@ -10,6 +10,19 @@ use paperbsdf_core::models::{ComponentModel, LambertGlass, LambertGlassParams, M
 use paperbsdf_core::paper::{Component, PaperBsdf};
 use paperbsdf_core::{Bsdf, DVec3, PaperParams, ParamError, Rgb, RoughDielectric, RoughDielectricParams};
 
+/// A component asked of a model that does not have it (`--component single`
+/// of `rough-dielectric`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("--component {component}: {model} has no such component (it has: {has}, all)")]
+pub struct MissingComponent {
+    /// The component asked for.
+    pub component: Component,
+    /// The model, as the message names it (`the model rough-dielectric`).
+    pub model: &'static str,
+    /// The model's components, comma-separated.
+    pub has: String,
+}
+
 /// A model loaded from a parameter file.
 pub enum LoadedModel {
     /// `paper` or `reduced-multilayer`.
@@ -117,32 +130,34 @@ impl LoadedModel {
         self.model().is_rgb()
     }
 
-    /// `f(wi, wo)` of one component (`surface`, `single`, `multiple`, `direct`) or `all`;
-    /// a component the model does not have is an error (not a silent zero).
-    pub fn eval_component(&self, wi: DVec3, wo: DVec3, component: &str) -> Result<Rgb, String> {
-        if component == "all" {
-            return Ok(self.model().eval(wi, wo));
-        }
-        match Component::parse(component) {
-            Some(c) if self.model().components().contains(&c) => Ok(self.model().eval_component(wi, wo, c)),
-            Some(c) => {
-                let name = match self {
+    /// Checks that the model has `component` (`None`: all of them, which
+    /// every model has): asking for a component it lacks is an error, not a
+    /// silent zero.
+    pub fn check_component(&self, component: Option<Component>) -> Result<(), MissingComponent> {
+        let has = self.model().components();
+        match component {
+            Some(c) if !has.contains(&c) => Err(MissingComponent {
+                component: c,
+                model: match self {
                     LoadedModel::Paper(_) => "this paper model",
                     LoadedModel::LambertGlass(_) => "the model lambert-glass",
                     LoadedModel::RoughDielectric(_) => "the model rough-dielectric",
                     LoadedModel::Measured(_) => "the measured BSDF",
-                };
-                let has: Vec<&str> = self.model().components().iter().map(|c| c.name()).collect();
-                Err(format!(
-                    "--component {}: {name} has no such component (it has: {}, all)",
-                    c.name(),
-                    has.join(", ")
-                ))
-            }
-            None => Err(format!(
-                "unknown component `{component}`: expected surface, single, multiple, direct or all"
-            )),
+                },
+                has: has.iter().map(|c| c.name()).collect::<Vec<_>>().join(", "),
+            }),
+            _ => Ok(()),
         }
+    }
+
+    /// `f(wi, wo)` of one component (`surface`, `single`, `multiple`,
+    /// `direct`) or, for `None`, of all; see [`LoadedModel::check_component`].
+    pub fn eval_component(&self, wi: DVec3, wo: DVec3, component: Option<Component>) -> Result<Rgb, MissingComponent> {
+        self.check_component(component)?;
+        Ok(match component {
+            None => self.model().eval(wi, wo),
+            Some(c) => self.model().eval_component(wi, wo, c),
+        })
     }
 
     /// Directional albedo `(reflectance, transmittance)` for light arriving from

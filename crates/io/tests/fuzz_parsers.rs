@@ -1,5 +1,5 @@
 //! Property-based fuzzing (proptest) of the io crate's parsers: parameter
-//! files (JSON and TOML), direction CSVs and angle lists. Arbitrary bytes and
+//! files (JSON and TOML), direction CSVs, measurement CSVs and angle lists. Arbitrary bytes and
 //! structured near-valid inputs must give `Ok` or an error naming the origin,
 //! never a panic, and never a large allocation (a counting allocator records
 //! the largest single request; inputs are at most a few kB, so any request
@@ -10,6 +10,7 @@
 use paperbsdf_core::PaperParams;
 use paperbsdf_io::angles::parse_angles;
 use paperbsdf_io::dirs::parse_dirs;
+use paperbsdf_io::measurement::{parse_measurement, read_measurement};
 use paperbsdf_io::params::parse_text;
 use proptest::prelude::*;
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -131,7 +132,64 @@ const CSV_BITS: &[&str] = &[
     " ",
     "\u{feff}",
 ];
+const MEASUREMENT_BITS: &[&str] = &[
+    "kind",
+    "theta_i_deg",
+    "theta_o_deg",
+    "f",
+    "r",
+    "g",
+    "b",
+    "stderr",
+    "stderr_r",
+    "wi_x",
+    "wi_y",
+    "wi_z",
+    "wo_x",
+    "wo_y",
+    "wo_z",
+    ",",
+    "\n",
+    "\r\n",
+    "# params: ",
+    "# thickness: ",
+    "{\"d\":0.1}",
+    "R",
+    "T",
+    "0",
+    "30",
+    "-45",
+    "90",
+    "0.5",
+    "1e300",
+    "nan",
+    "-1",
+    "#",
+    " ",
+    "\u{feff}",
+];
+
 const GOOD: &str = r#"{"d":0.1,"sigma_a":0.6,"sigma_s":[120,110,100],"g_f":0.85,"g_b":-0.4,"w_b":0.15,"eta_f":1.45,"eta_b":1.45,"m_f":0.35,"m_b":0.35,"dist_f":"ggx","dist_b":"ggx"}"#;
+
+/// Issue 16: with a BOM the first comment line of a measurement file was taken for the header.
+#[test]
+fn measurement_byte_order_mark_is_accepted() {
+    let body = "# thickness: 0.1\nkind,theta_i_deg,theta_o_deg,f\nR,30,-30,0.5\nT,30,10,0.25\n";
+    let plain = parse_measurement(body, "m.csv").unwrap();
+    let bom = parse_measurement(&format!("\u{feff}{body}"), "m.csv").unwrap();
+    assert_eq!(bom.points, plain.points);
+    assert_eq!(bom.thickness, Some(0.1));
+    // From a file too.
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("bom.csv");
+    std::fs::write(&p, format!("\u{feff}{body}")).unwrap();
+    let m = read_measurement(p.to_str().unwrap()).unwrap();
+    assert_eq!(m.points.len(), 2);
+    assert_eq!(m.points[0].line, 3);
+    // Header first, with a BOM.
+    let m = parse_measurement("\u{feff}kind,theta_i_deg,theta_o_deg,f\nR,0,0,1\n", "m.csv").unwrap();
+    assert_eq!(m.points.len(), 1);
+}
 
 proptest! {
     #![proptest_config(ProptestConfig { cases: 400, failure_persistence: None, ..ProptestConfig::default() })]
@@ -241,6 +299,47 @@ proptest! {
                 }
                 Err(e) => assert!(e.0.contains(&format!("`{s}`")), "the error quotes the input: {}", e.0),
             }
+        }
+        bounded();
+    }
+
+    #[test]
+    fn measurement_from_arbitrary_bytes(bytes in prop::collection::vec(any::<u8>(), 0..512)) {
+        let text = String::from_utf8_lossy(&bytes);
+        if let Err(e) = parse_measurement(&text, "fuzz.csv") {
+            assert!(e.to_string().starts_with("fuzz.csv"), "{e}");
+        }
+        bounded();
+    }
+
+    #[test]
+    fn measurement_from_near_valid_text(parts in prop::collection::vec(prop_oneof![
+        4 => prop::sample::select(MEASUREMENT_BITS).prop_map(str::to_string),
+        1 => "[ -~\\n]{0,6}",
+        1 => prop::num::f64::ANY.prop_map(|x| x.to_string()),
+    ], 0..60)) {
+        let text = parts.concat();
+        match parse_measurement(&text, "fuzz.csv") {
+            Ok(m) => for p in &m.points {
+                assert!(p.f.0.iter().all(|v| v.is_finite()), "accepted a non-finite value: {text}");
+                assert!(p.wi.is_finite() && p.wo.is_finite());
+            },
+            Err(e) => assert!(e.to_string().starts_with("fuzz.csv"), "{e}"),
+        }
+        bounded();
+    }
+
+    /// Structured rows: arbitrary numbers under a valid in-plane header.
+    #[test]
+    fn measurement_in_plane_rows_with_arbitrary_numbers(rows in prop::collection::vec(
+        (any::<bool>(), prop::num::f64::ANY, prop::num::f64::ANY, prop::num::f64::ANY), 0..20)) {
+        let mut text = String::from("kind,theta_i_deg,theta_o_deg,f\n");
+        for (r, ti, to, f) in &rows {
+            text.push_str(&format!("{},{ti},{to},{f}\n", if *r { "R" } else { "T" }));
+        }
+        match parse_measurement(&text, "fuzz.csv") {
+            Ok(m) => assert_eq!(m.points.len(), rows.len()),
+            Err(e) => assert!(e.to_string().starts_with("fuzz.csv:"), "{e}"),
         }
         bounded();
     }

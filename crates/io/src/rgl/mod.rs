@@ -113,7 +113,8 @@ impl MeasuredBsdf {
             file: origin.to_string(),
             message,
         };
-        let tf = TensorFile::parse(bytes).map_err(err)?;
+        let terr = |e: tensor::TensorError| err(e.0);
+        let tf = TensorFile::parse(bytes).map_err(terr)?;
         if tf.fields.contains_key("wavelengths") || tf.fields.contains_key("spectra") {
             return Err(err(
                 "this is a spectral RGL file (fields `wavelengths`, `spectra`), which is not supported: \
@@ -122,7 +123,7 @@ impl MeasuredBsdf {
             ));
         }
         let shape = |name: &str, rank: usize| -> Result<Vec<usize>, DataError> {
-            let f = tf.field(name).map_err(err)?;
+            let f = tf.field(name).map_err(terr)?;
             if f.shape.len() != rank {
                 return Err(err(format!(
                     "field `{name}` has shape {:?} (rank {}), expected rank {rank}",
@@ -132,7 +133,7 @@ impl MeasuredBsdf {
             }
             Ok(f.shape.clone())
         };
-        let floats = |name: &str| -> Result<Vec<f32>, DataError> { tf.f32s(name).map_err(err) };
+        let floats = |name: &str| -> Result<Vec<f32>, DataError> { tf.f32s(name).map_err(terr) };
         let theta_i = shape("theta_i", 1)?;
         let phi_i = shape("phi_i", 1)?;
         let ndf_s = shape("ndf", 2)?;
@@ -140,8 +141,8 @@ impl MeasuredBsdf {
         let vndf_s = shape("vndf", 4)?;
         let lum_s = shape("luminance", 4)?;
         let rgb_s = shape("rgb", 5)?;
-        let jac = tf.field("jacobian").map_err(err)?;
-        let desc = tf.field("description").map_err(err)?;
+        let jac = tf.field("jacobian").map_err(terr)?;
+        let desc = tf.field("description").map_err(terr)?;
         let (np, nt) = (phi_i[0], theta_i[0]);
         let want = |name: &str, got: &[usize], expected: String| -> Result<(), DataError> {
             Err(err(format!("field `{name}` has shape {got:?}, expected {expected}")))
@@ -186,7 +187,7 @@ impl MeasuredBsdf {
             }
             reduction = (2.0 * PI / span).round() as i32;
         }
-        let bad = |name: &'static str| move |m: String| err(format!("field `{name}`: {m}"));
+        let bad = |name: &'static str| move |m: warp::WarpError| err(format!("field `{name}`: {m}"));
         let params = vec![phi.clone(), theta.clone()];
         let ndf = Warp2D::new(&floats("ndf")?, ndf_s[1], ndf_s[0], vec![], false, false).map_err(bad("ndf"))?;
         let sigma =

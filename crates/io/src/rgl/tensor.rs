@@ -14,6 +14,23 @@
 
 use std::collections::BTreeMap;
 
+/// What is wrong with the bytes of a tensor file (the caller adds the file name).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct TensorError(pub String);
+
+impl From<String> for TensorError {
+    fn from(m: String) -> Self {
+        TensorError(m)
+    }
+}
+
+impl From<&str> for TensorError {
+    fn from(m: &str) -> Self {
+        TensorError(m.to_string())
+    }
+}
+
 /// The magic bytes at the start of every tensor file.
 pub const MAGIC: &[u8; 12] = b"tensor_file\0";
 
@@ -131,7 +148,7 @@ struct Cursor<'a> {
 }
 
 impl Cursor<'_> {
-    fn take(&mut self, n: usize, what: &str) -> Result<&[u8], String> {
+    fn take(&mut self, n: usize, what: &str) -> Result<&[u8], TensorError> {
         let end = self.p.checked_add(n).filter(|&e| e <= self.b.len());
         match end {
             Some(e) => {
@@ -139,22 +156,22 @@ impl Cursor<'_> {
                 self.p = e;
                 Ok(s)
             }
-            None => Err(format!(
+            None => Err(TensorError(format!(
                 "truncated header: {what} at byte {} needs {n} bytes, the file has {}",
                 self.p,
                 self.b.len()
-            )),
+            ))),
         }
     }
-    fn u16(&mut self, what: &str) -> Result<u16, String> {
+    fn u16(&mut self, what: &str) -> Result<u16, TensorError> {
         let s = self.take(2, what)?;
         Ok(u16::from_le_bytes([s[0], s[1]]))
     }
-    fn u32(&mut self, what: &str) -> Result<u32, String> {
+    fn u32(&mut self, what: &str) -> Result<u32, TensorError> {
         let s = self.take(4, what)?;
         Ok(u32::from_le_bytes(s.try_into().expect("4 bytes")))
     }
-    fn u64(&mut self, what: &str) -> Result<u64, String> {
+    fn u64(&mut self, what: &str) -> Result<u64, TensorError> {
         let s = self.take(8, what)?;
         Ok(u64::from_le_bytes(s.try_into().expect("8 bytes")))
     }
@@ -163,38 +180,37 @@ impl Cursor<'_> {
 impl TensorFile {
     /// Parses the bytes of a tensor file. The error says what is wrong (the
     /// caller adds the file name).
-    pub fn parse(bytes: Vec<u8>) -> Result<TensorFile, String> {
+    pub fn parse(bytes: Vec<u8>) -> Result<TensorFile, TensorError> {
         if bytes.is_empty() {
-            return Err("the file is empty (expected a tensor_file)".into());
+            return Err(TensorError::from("the file is empty (expected a tensor_file)"));
         }
         if bytes.len() < 18 || &bytes[..12] != MAGIC {
             if bytes.len() >= 12 && &bytes[..12] == MAGIC {
-                return Err(format!(
+                return Err(TensorError::from(format!(
                     "truncated header: {} bytes, a tensor file header has at least 18",
                     bytes.len()
-                ));
+                )));
             }
-            return Err(
+            return Err(TensorError::from(
                 "not a tensor file: it does not start with the magic bytes `tensor_file\\0` \
-                 (RGL material files are `.bsdf` tensor files)"
-                    .into(),
-            );
+                 (RGL material files are `.bsdf` tensor files)",
+            ));
         }
         let mut c = Cursor { b: &bytes, p: 12 };
         let ver = c.take(2, "version")?;
         if ver != [1, 0] {
-            return Err(format!(
+            return Err(TensorError::from(format!(
                 "unknown tensor file version {}.{} (only 1.0 is known)",
                 ver[0], ver[1]
-            ));
+            )));
         }
         let n = c.u32("field count")? as usize;
         // Each field header has at least 2 + 2 + 1 + 8 bytes: a count the file cannot hold is refused before any allocation.
         if n > bytes.len() / 13 {
-            return Err(format!(
+            return Err(TensorError::from(format!(
                 "truncated or corrupt header: it declares {n} fields, more than a file of {} bytes can hold",
                 bytes.len()
-            ));
+            )));
         }
         let mut fields = BTreeMap::new();
         for k in 0..n {
@@ -209,9 +225,9 @@ impl TensorFile {
             let offset = c.u64(&format!("offset of field `{name}`"))?;
             // the shape bytes must be present before the vector is allocated
             if ndim.checked_mul(8).is_none_or(|s| c.p + s > bytes.len()) {
-                return Err(format!(
+                return Err(TensorError::from(format!(
                     "truncated header: the shape of field `{name}` (rank {ndim}) runs past the end of the file"
-                ));
+                )));
             }
             let mut shape = Vec::with_capacity(ndim);
             let mut count: u64 = 1;
@@ -227,13 +243,13 @@ impl TensorFile {
                 .ok_or_else(|| format!("field `{name}`: size overflows"))?;
             let end = offset.checked_add(nbytes);
             if end.is_none_or(|e| e > bytes.len() as u64) {
-                return Err(format!(
+                return Err(TensorError::from(format!(
                     "truncated file: field `{name}` ({} x {:?}) needs bytes {offset}..{} but the file has {} bytes",
                     dtype.name(),
                     shape,
                     offset as u128 + nbytes as u128,
                     bytes.len()
-                ));
+                )));
             }
             if fields
                 .insert(
@@ -247,7 +263,7 @@ impl TensorFile {
                 )
                 .is_some()
             {
-                return Err(format!("field `{name}` appears twice"));
+                return Err(TensorError::from(format!("field `{name}` appears twice")));
             }
         }
         Ok(TensorFile { fields, bytes })
@@ -288,12 +304,12 @@ impl TensorFile {
     }
 
     /// The field `name`, or an error naming it.
-    pub fn field(&self, name: &str) -> Result<&Field, String> {
+    pub fn field(&self, name: &str) -> Result<&Field, TensorError> {
         self.fields.get(name).ok_or_else(|| {
-            format!(
+            TensorError(format!(
                 "missing field `{name}` (fields present: {})",
                 self.fields.keys().cloned().collect::<Vec<_>>().join(", ")
-            )
+            ))
         })
     }
 
@@ -303,10 +319,13 @@ impl TensorFile {
     }
 
     /// The elements of a float32 field, as f32.
-    pub fn f32s(&self, name: &str) -> Result<Vec<f32>, String> {
+    pub fn f32s(&self, name: &str) -> Result<Vec<f32>, TensorError> {
         let f = self.field(name)?;
         if f.dtype != DType::F32 {
-            return Err(format!("field `{name}` has type {}, expected float32", f.dtype.name()));
+            return Err(TensorError::from(format!(
+                "field `{name}` has type {}, expected float32",
+                f.dtype.name()
+            )));
         }
         Ok(self
             .bytes(f)

@@ -11,6 +11,23 @@
 //! the RGL files store reflectance on its output domain, so evaluating a BRDF
 //! means inverting the warp of the visible normal distribution.
 
+/// What is wrong with the tables of a warp (the caller names the field).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct WarpError(pub String);
+
+impl From<String> for WarpError {
+    fn from(m: String) -> Self {
+        WarpError(m)
+    }
+}
+
+impl From<&str> for WarpError {
+    fn from(m: &str) -> Self {
+        WarpError(m.to_string())
+    }
+}
+
 /// A bilinear density on the unit square with its cumulative tables, one slice
 /// per combination of parameter grid values.
 #[derive(Clone, Debug)]
@@ -48,31 +65,39 @@ impl Warp2D {
         params: Vec<Vec<f64>>,
         normalize: bool,
         cdf: bool,
-    ) -> Result<Warp2D, String> {
+    ) -> Result<Warp2D, WarpError> {
         if w < 2 || h < 2 {
-            return Err(format!("a {w} x {h} grid is too small (at least 2 x 2)"));
+            return Err(WarpError::from(format!(
+                "a {w} x {h} grid is too small (at least 2 x 2)"
+            )));
         }
         let mut slices = 1usize;
         let mut strides = vec![0; params.len()];
         for (i, p) in params.iter().enumerate().rev() {
             if p.is_empty() {
-                return Err("a parameter grid is empty".into());
+                return Err(WarpError::from("a parameter grid is empty"));
             }
             if p.windows(2)
                 .any(|v| v[1].partial_cmp(&v[0]) != Some(std::cmp::Ordering::Greater))
                 || p.iter().any(|v| !v.is_finite())
             {
-                return Err("a parameter grid is not strictly increasing and finite".into());
+                return Err(WarpError::from(
+                    "a parameter grid is not strictly increasing and finite",
+                ));
             }
             strides[i] = if p.len() > 1 { slices } else { 0 };
             slices *= p.len();
         }
         let n = w * h;
         if data.len() != slices * n {
-            return Err(format!("{} values where the shapes need {}", data.len(), slices * n));
+            return Err(WarpError::from(format!(
+                "{} values where the shapes need {}",
+                data.len(),
+                slices * n
+            )));
         }
         if data.iter().any(|v| !v.is_finite()) {
-            return Err("a value is not finite".into());
+            return Err(WarpError::from("a value is not finite"));
         }
         let (sx, sy) = (0.5 / (w - 1) as f64, 0.5 / (h - 1) as f64);
         let mut out = Vec::with_capacity(slices * n);
@@ -99,7 +124,9 @@ impl Warp2D {
                 }
                 if normalize {
                     if acc.is_nan() || acc <= 0.0 {
-                        return Err(format!("slice {s} has no positive integral and cannot be normalised"));
+                        return Err(WarpError::from(format!(
+                            "slice {s} has no positive integral and cannot be normalised"
+                        )));
                     }
                     norm = 1.0 / acc;
                     cond[c0..].iter_mut().for_each(|v| *v *= norm);
@@ -114,7 +141,9 @@ impl Warp2D {
                     }
                 }
                 if sum.is_nan() || sum <= 0.0 {
-                    return Err(format!("slice {s} has no positive integral and cannot be normalised"));
+                    return Err(WarpError::from(format!(
+                        "slice {s} has no positive integral and cannot be normalised"
+                    )));
                 }
                 norm = 1.0 / (sx * sy * sum);
             }

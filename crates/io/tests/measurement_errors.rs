@@ -1,7 +1,7 @@
 //! Bad measurement files are errors that name the file, line and column;
 //! good files in both layouts are read, including the reference files.
 
-use paperbsdf_fit::{parse_measurement, read_measurement, Kind};
+use paperbsdf_io::measurement::{parse_measurement, read_measurement, Kind};
 
 mod common;
 

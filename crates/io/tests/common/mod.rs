@@ -1,5 +1,6 @@
-//! Where this crate's tests find the independent reference data: the repository's
+//! Where the tests find the independent reference data: the repository's
 //! `data/reference` (provenance in its README), or `$PAPERBSDF_REFERENCE` if set.
+//! Used by this crate's tests and, through `#[path]`, by the CLI's.
 #![allow(dead_code)]
 
 use std::path::PathBuf;
