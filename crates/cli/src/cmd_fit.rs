@@ -52,6 +52,14 @@ pub struct FitArgs {
     /// Hold a parameter at a value (repeatable): e.g. `--fix eta_f=1.5 --fix m_b=0.4`; a colour parameter's name fixes all its channels.
     #[arg(long = "fix", value_name = "NAME=VALUE")]
     pub fix: Vec<String>,
+    /// The model's own error (RMS log error) used for the uncertainty intervals of the report: a value
+    /// fits "within the model's error" when its refitted error stays within sqrt(E0^2 + max(RMS, E0)^2),
+    /// E0 the fit's error. Default 0.05, the model's documented accuracy in reflection (docs/accuracy.md).
+    #[arg(long = "model-error", value_name = "RMS", default_value_t = paperbsdf_fit::report::MODEL_ERROR_RMS)]
+    pub model_error: f64,
+    /// Linearised uncertainty intervals only (no profile refits: faster, but the intervals can be too narrow).
+    #[arg(long = "no-profile")]
+    pub no_profile: bool,
     /// Leave out reflection points whose viewer is within DEG degrees of the light (where a goniometer's detector blocks the light).
     #[arg(long = "exclude-retro", value_name = "DEG")]
     pub exclude_retro: Option<f64>,
@@ -73,6 +81,9 @@ fn rms_over(model: &dyn paperbsdf_fit::Evaluable, pts: &[&Point], channels: usiz
 pub fn run(args: FitArgs) -> Result<()> {
     if args.samples == 0 || args.starts == 0 || args.max_iter == 0 {
         bail!("--samples, --starts and --max-iter must be at least 1");
+    }
+    if !(args.model_error >= 0.0 && args.model_error.is_finite()) {
+        bail!("--model-error {} must be a finite RMS log error >= 0", args.model_error);
     }
     if let Some(out) = &args.out {
         // Before the fit, not after it (issue 16).
@@ -176,6 +187,11 @@ pub fn run(args: FitArgs) -> Result<()> {
         fit_theta_i: fit_theta_i.clone(),
         seed: args.seed,
         progress: true,
+        report: paperbsdf_fit::report::ReportSettings {
+            model_error: args.model_error,
+            profile: !args.no_profile,
+            ..Default::default()
+        },
         ..Default::default()
     };
     let out = fit(&ds.points, ds.channels, &cands, &opts)?;
@@ -238,6 +254,11 @@ pub fn run(args: FitArgs) -> Result<()> {
             "what the data determine ({} values, {} free parameters; {} undetermined combination(s)):",
             id.values, id.free_params, id.undetermined_combinations
         );
+        println!(
+            "  interval: values whose refitted RMS log error stays within {:.4} (the fit's {:.4} and the model's own error {:.3}); \
+             it holds the true value if the model at the true parameters fits that well. stderr: from the noise alone",
+            id.interval_level, out.rms_log_error, id.model_error_scale
+        );
         for p in &id.params {
             let status = if p.on_bound {
                 "ON BOUND"
@@ -246,7 +267,14 @@ pub fn run(args: FitArgs) -> Result<()> {
             } else {
                 "not determined"
             };
-            println!("  {:<12} {:>12.6} +- {:<10.3e} {status}", p.name, p.value, p.stderr);
+            let method = match p.interval_method {
+                paperbsdf_fit::report::IntervalMethod::Profile => "",
+                paperbsdf_fit::report::IntervalMethod::Linear => " (linearised)",
+            };
+            println!(
+                "  {:<12} {:>12.6}  interval [{:.6}, {:.6}]{method}  stderr {:<10.3e} {status}",
+                p.name, p.value, p.interval[0], p.interval[1], p.stderr
+            );
         }
     }
     if !fixes.is_empty() {

@@ -8,7 +8,7 @@ use crate::measurement::{Kind, Point};
 use crate::model::{Evaluable, FitModel};
 use crate::objective::{residuals, rms_log_error, sqrt_weights};
 use crate::optimize::{levenberg_marquardt, LmSettings, Stop};
-use crate::report::{check_data, identifiability, Identifiability, MEANINGLESS_RMS};
+use crate::report::{check_data, identifiability, Identifiability, ReportSettings, MEANINGLESS_RMS};
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
@@ -39,6 +39,8 @@ pub struct FitOptions {
     pub seed: u64,
     /// Show a progress bar on stderr.
     pub progress: bool,
+    /// How the identifiability report is computed (model error scale, profile checks).
+    pub report: ReportSettings,
 }
 
 impl Default for FitOptions {
@@ -54,6 +56,7 @@ impl Default for FitOptions {
             hop_starts: 4,
             seed: 1,
             progress: false,
+            report: ReportSettings::default(),
         }
     }
 }
@@ -373,27 +376,36 @@ pub fn fit(
             limit: MEANINGLESS_RMS,
         });
     }
-    let ident = identifiability(c, &best.u, &fitted, &sw, channels);
+    let ident = identifiability(c, &best.u, &fitted, &sw, channels, &opts.report);
     let mut warnings = Vec::new();
     if let Some(id) = &ident {
+        evaluations += id.evaluations;
         for p in &id.params {
+            let fix = p.name.split('[').next().unwrap_or(&p.name);
             if p.on_bound {
                 warnings.push(format!(
-                    "{} = {:.6} ended on a bound of its search range [{}, {}]: the data push it beyond what the model allows; its value is not a measurement (hold it with --fix {}=VALUE)",
-                    p.name, p.value, p.bounds[0], p.bounds[1], p.name.split('[').next().unwrap_or(&p.name)
+                    "{} = {:.6} ended on a bound of its search range [{}, {}]: the data push it beyond what the model allows; its value is not a measurement (hold it with --fix {fix}=VALUE)",
+                    p.name, p.value, p.bounds[0], p.bounds[1]
                 ));
             } else if !p.determined {
-                let how = if p.stderr_unit.is_finite() {
+                let how = if p.interval_width_unit.is_finite() {
                     format!(
-                        "standard error {:.3e}, {:.0}% of its search range",
-                        p.stderr,
-                        100.0 * p.stderr_unit
+                        "any value from {:.4e} to {:.4e} ({:.0}% of its search range{}) fits within the model's own error, RMS log error {:.3}",
+                        p.interval[0],
+                        p.interval[1],
+                        100.0 * p.interval_width_unit,
+                        if p.interval_method == crate::report::IntervalMethod::Linear {
+                            ", linearised"
+                        } else {
+                            ""
+                        },
+                        id.interval_level
                     )
                 } else {
                     "no constraint at all: it trades off exactly against other parameters".to_string()
                 };
                 warnings.push(format!(
-                    "{} = {:.6} is not determined by the data ({how})",
+                    "{} = {:.6} is not determined by the data: {how}; hold it at a plausible value with --fix {fix}=VALUE",
                     p.name, p.value
                 ));
             }
@@ -438,6 +450,7 @@ impl FitOutcome {
             "evaluations": self.evaluations,
             "stop": self.stop,
             "identifiability": self.identifiability,
+            "uncertainty_definition": crate::report::UNCERTAINTY_DEFINITION,
             "warnings": self.warnings,
             "error_definition": format!(
                 "sqrt(sum w r^2 / sum w), r = ln((f_model + {e}) / (f_meas + {e})), w = 1/max(stderr/(f_meas + {e}), {s})^2 when stderr is given, else 1",

@@ -11,7 +11,8 @@
 //! * [`optimize`]: bounded Levenberg-Marquardt in the unit cube;
 //! * [`dataset`]: several files fitted together, thickness from headers;
 //! * [`measured`]: sampling a measured `.bsdf` file, goniometer filters, measured albedo;
-//! * [`report`]: what the data determine (uncertainties, bounds) and degenerate-data checks;
+//! * [`report`]: what the data determine (each parameter's interval within the model's
+//!   own error, from profile refits; noise standard errors; bounds) and degenerate-data checks;
 //! * [`fitter`]: global multi-start search plus local refinement, scoring of
 //!   fitted and extrapolation points.
 
