@@ -1,9 +1,9 @@
 //! `paperbsdf convert`: samples a measured RGL `.bsdf` file on in-plane angles
 //! and writes the measurement CSV that `fit` and `plot` read
-//! (`kind,theta_i_deg,theta_o_deg,r,g,b`, reflection only; DESIGN.md section 2).
+//! (`kind,theta_i_deg,theta_o_deg,r,g,b`, reflection only; docs/design.md section 2).
 
 use crate::cmd_eval::MAX_EVAL_ANGLES;
-use anyhow::{anyhow, bail, Result};
+use anyhow::{bail, Result};
 use paperbsdf_fit::measured::{sample_in_plane, PointFilter};
 use paperbsdf_io::angles::check_angles;
 
@@ -38,7 +38,7 @@ pub fn run(a: ConvertArgs) -> Result<()> {
         exclude_retro_deg: a.exclude_retro,
         max_theta_deg: a.max_theta,
     };
-    filter.validate().map_err(|e| anyhow!(e))?;
+    filter.validate()?;
     let b = paperbsdf_io::MeasuredBsdf::load(&a.file)?;
     let mut text = format!(
         "# measured BSDF {} (\"{}\"), RGL tensor file, sampled by paperbsdf convert; f without cosine, reflection only\n",

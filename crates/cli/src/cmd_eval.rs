@@ -1,5 +1,5 @@
 //! `paperbsdf eval` and `paperbsdf albedo`: a model's BSDF values and directional
-//! albedo, in the conventions of DESIGN.md section 2.
+//! albedo, in the conventions of docs/design.md section 2.
 
 use crate::choices::{self, ComponentChoice};
 use anyhow::{bail, Result};

@@ -1,11 +1,11 @@
 //! `paperbsdf fit`: fits a model to in-plane (or general) BSDF measurements
-//! (DESIGN.md section 5; crate paperbsdf-fit) or to a measured RGL `.bsdf`
+//! (docs/design.md section 5; crate paperbsdf-fit) or to a measured RGL `.bsdf`
 //! file (sampled in and out of the plane of incidence,
 //! [`paperbsdf_fit::measured`]), and writes FIT.json with the errors, what the
 //! data determine, and warnings.
 
 use crate::choices;
-use anyhow::{anyhow, bail, Result};
+use anyhow::{bail, Result};
 use paperbsdf_core::{Distribution, FaceScattering};
 use paperbsdf_fit::dataset::load_dataset;
 use paperbsdf_fit::measured::{directional_albedo, in_plane, sample_measured, PointFilter, Sampling};
@@ -73,7 +73,7 @@ pub fn is_bsdf_file(path: &str) -> bool {
     path.to_ascii_lowercase().ends_with(".bsdf")
 }
 
-fn rms_over(model: &dyn paperbsdf_fit::Evaluable, pts: &[&Point], channels: usize) -> Option<f64> {
+fn rms_over(model: &dyn paperbsdf_fit::ComponentModel, pts: &[&Point], channels: usize) -> Option<f64> {
     paperbsdf_fit::objective::rms_log_error(model, pts, channels).map(|e| e.0)
 }
 
@@ -93,17 +93,12 @@ pub fn run(args: FitArgs) -> Result<()> {
         exclude_retro_deg: args.exclude_retro,
         max_theta_deg: args.max_theta,
     };
-    filter.validate().map_err(|e| anyhow!(e))?;
-    let fixes = args
-        .fix
-        .iter()
-        .map(|f| parse_fix(f))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| anyhow!(e))?;
+    filter.validate()?;
+    let fixes = args.fix.iter().map(|f| parse_fix(f)).collect::<Result<Vec<_>, _>>()?;
     let bsdf_files: Vec<&String> = args.data.iter().filter(|p| is_bsdf_file(p)).collect();
     let mut albedo_rows: Vec<(f64, paperbsdf_core::Rgb)> = Vec::new();
     let mut ds = if bsdf_files.is_empty() {
-        load_dataset(&args.data, args.thickness).map_err(|e| anyhow!(e))?
+        load_dataset(&args.data, args.thickness)?
     } else {
         if args.data.len() != 1 {
             bail!(
@@ -173,9 +168,8 @@ pub fn run(args: FitArgs) -> Result<()> {
         ds.channels == 3,
         Some(&args.dists),
         args.face_scattering,
-    )
-    .map_err(|e| anyhow!(e))?;
-    let cands = fix_params(cands, &fixes).map_err(|e| anyhow!(e))?;
+    )?;
+    let cands = fix_params(cands, &fixes)?;
     let fit_theta_i = (!args.fit_theta_i.is_empty()).then(|| args.fit_theta_i.clone());
     let opts = FitOptions {
         global_samples: args.samples,
@@ -215,7 +209,7 @@ pub fn run(args: FitArgs) -> Result<()> {
         );
     }
     // In-plane and out-of-plane errors, on the fitted and the extrapolation points.
-    let model = cands[out.variant_index].build(&out.x).map_err(|e| anyhow!(e))?;
+    let model = cands[out.variant_index].build(&out.x)?;
     let (fitted, extra) = paperbsdf_fit::fitter::split_points(&ds.points, fit_theta_i.as_deref());
     fn part<'a>(pts: &[&'a Point], plane: bool) -> Vec<&'a Point> {
         pts.iter().copied().filter(|p| in_plane(p) == plane).collect()

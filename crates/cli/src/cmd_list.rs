@@ -1,5 +1,5 @@
 //! `paperbsdf list`: the models with their parameters (names, units and ranges
-//! of DESIGN.md section 3) and the paper presets of `paperbsdf_core::presets`
+//! of docs/design.md section 3) and the paper presets of `paperbsdf_core::presets`
 //! with their values, so that a newcomer can pick one by name
 //! (`--params matte`) without reading the source.
 
@@ -25,7 +25,7 @@ pub enum What {
     All,
 }
 
-/// The parameters of the Paper BSDF: name, range, meaning (DESIGN.md section 3).
+/// The parameters of the Paper BSDF: name, range, meaning (docs/design.md section 3).
 pub const PAPER_PARAMS: [(&str, &str, &str); 13] = [
     ("d", "(0, inf) mm", "thickness"),
     ("sigma_a", "[0, inf) 1/mm, number or [r,g,b]", "absorption coefficient"),

@@ -5,6 +5,7 @@
 //! `docs/paper_metrics.md`.
 
 use anyhow::{bail, Context, Result};
+use paperbsdf_core::models::ModelKind;
 use paperbsdf_core::PaperParams;
 use paperbsdf_io::models::{load_model, LoadedModel};
 use paperbsdf_metrics::edge::{model_edge, truth_edge, EdgeProfile, ScatterDistance, SUPPLEMENT_BLUR_MM};
@@ -134,7 +135,7 @@ pub fn run_measure(a: MeasureArgs) -> Result<()> {
         }
     }
     let m = if a.truth {
-        if a.model != "paper" {
+        if a.model != ModelKind::Paper.name() {
             bail!(
                 "--truth simulates the physical paper sheet: it needs --model paper (got `{}`)",
                 a.model

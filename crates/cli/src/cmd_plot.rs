@@ -216,7 +216,7 @@ pub fn run(args: PlotArgs) -> Result<()> {
         exclude_retro_deg: args.exclude_retro,
         max_theta_deg: args.max_theta,
     };
-    filter.validate().map_err(|e| anyhow!(e))?;
+    filter.validate()?;
     let any_bsdf = args.data.iter().any(|p| is_bsdf_file(p));
     let (theta_i, theta_o) = if any_bsdf {
         let ti = if args.theta_i.is_empty() {
@@ -243,7 +243,7 @@ pub fn run(args: PlotArgs) -> Result<()> {
         let ds = if is_bsdf_file(path) {
             bsdf_dataset(path, &theta_i, &theta_o, &filter)?
         } else {
-            let mut ds = load_dataset(std::slice::from_ref(path), None).map_err(|e| anyhow!(e))?;
+            let mut ds = load_dataset(std::slice::from_ref(path), None)?;
             ds.points = filter.apply(std::mem::take(&mut ds.points));
             if ds.points.is_empty() {
                 bail!("{path}: every point was left out by --exclude-retro / --max-theta: nothing to plot");

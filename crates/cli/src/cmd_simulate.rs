@@ -1,6 +1,6 @@
 //! `paperbsdf simulate`: the ground truth. Monte Carlo simulation of the physical
 //! paper slab (crate `paperbsdf-sim`): in-plane BSDF values with standard errors,
-//! or total reflectance and transmittance, in the conventions of DESIGN.md
+//! or total reflectance and transmittance, in the conventions of docs/design.md
 //! section 2 (`f` without cosine; `theta_o` signed, negative on the side
 //! opposite the light; `R` rows seen from `z > 0`, `T` rows from `z < 0`).
 

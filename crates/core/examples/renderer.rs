@@ -2,7 +2,7 @@
 //!
 //! A renderer has world-space directions and a shading normal; the BSDF works
 //! in a local frame with the sheet's front normal `+z`, `wi` toward the light
-//! and `wo` toward the viewer, values without the cosine (DESIGN.md section 2).
+//! and `wo` toward the viewer, values without the cosine (docs/design.md section 2).
 //! This program builds that frame, evaluates the BSDF for a light (next-event
 //! estimation), samples it to continue a path, and checks the sampled
 //! estimate of the sheet's reflectance and transmittance against quadrature.

@@ -1,7 +1,7 @@
 //! The interface every scattering model of the project implements.
 //!
 //! Modelled on pbrt-v4's `BxDF` (`f`, `Sample_f`, `PDF`, `Flags`) in the
-//! conventions of DESIGN.md section 2: directions are unit vectors in the local
+//! conventions of docs/design.md section 2: directions are unit vectors in the local
 //! frame whose `+z` is the macro normal of the front face; `wi` points toward the
 //! light, `wo` toward the viewer; `eval` is the BSDF *without* the cosine factor,
 //! for radiance transport. `sample` is given `wo` and draws `wi`, as a path tracer

@@ -50,9 +50,9 @@ pub struct RoughDielectric {
     pub interface: Interface,
 }
 
-/// Allowed range of `eta` (DESIGN.md section 3).
+/// Allowed range of `eta` (docs/design.md section 3).
 pub const ETA_RANGE: (f64, f64) = (1.0, 5.0);
-/// Allowed range of `m` (DESIGN.md section 3).
+/// Allowed range of `m` (docs/design.md section 3).
 pub const M_RANGE: (f64, f64) = (0.0, std::f64::consts::FRAC_PI_2);
 
 /// Roughness below which an interface is smooth (the limit `m -> 0`). A
@@ -65,7 +65,7 @@ pub const M_SMOOTH: f64 = 1e-4;
 
 impl RoughDielectric {
     /// A boundary with the given parameters; an error names any value outside
-    /// DESIGN.md's ranges (`eta` in [1, 5], `m` in [0, pi/2]).
+    /// docs/design.md's ranges (`eta` in [1, 5], `m` in [0, pi/2]).
     pub fn new(dist: Distribution, eta: f64, m: f64) -> Result<Self, ParamError> {
         ParamError::check_range("eta", eta, ETA_RANGE.0, ETA_RANGE.1)?;
         ParamError::check_range("m", m, M_RANGE.0, M_RANGE.1)?;

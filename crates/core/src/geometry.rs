@@ -46,7 +46,7 @@ pub fn spherical_direction(theta: f64, phi: f64) -> DVec3 {
     DVec3::new(st * cp, st * sp, ct)
 }
 
-/// Directions of an in-plane measurement (DESIGN.md section 2): the light at
+/// Directions of an in-plane measurement (docs/design.md section 2): the light at
 /// `theta_i_deg` on the `+x` side above the front face; the viewer at signed
 /// `theta_o_deg` (positive on the light's side), above the sheet for reflection,
 /// below it (measured from `-z`) for transmission. Returns `(wi, wo)`.

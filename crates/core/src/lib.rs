@@ -1,7 +1,7 @@
 //! # paperbsdf-core
 //!
 //! The Paper BSDF of Papas, de Mesa and Jensen (EGSR 2014) and its building
-//! blocks, in the conventions of the project's DESIGN.md (section 2): local frame
+//! blocks, in the conventions of docs/design.md (section 2): local frame
 //! with the front face's macro normal `+z`, `f(wi, wo)` without cosine, `wi`
 //! toward the light, `wo` toward the viewer, lengths in millimetres.
 //!

@@ -1,5 +1,5 @@
 //! The multiple-scattering rough dielectric face: a random walk on the Smith
-//! microsurface (DESIGN.md 4.1, `face_scattering = "multiple"`).
+//! microsurface (docs/design.md 4.1, `face_scattering = "multiple"`).
 //!
 //! Source: Heitz, Hanika, d'Eon, Dachsbacher, "Multiple-scattering microfacet
 //! BSDFs with the Smith model", SIGGRAPH 2016, dielectric case. Light meets the

@@ -2,7 +2,7 @@
 //! multiple-scattering face ([`crate::microsurface`]) returns: for diffuse
 //! light, the fractions carried by orders >= 2 of the walk on the Smith
 //! microsurface (Heitz, Hanika, d'Eon, Dachsbacher 2016), for the model's
-//! compensation of energy-conserving faces (DESIGN.md 4.1).
+//! compensation of energy-conserving faces (docs/design.md 4.1).
 //!
 //! At every other (distribution, eta, m) node of the grid of
 //! [`crate::boundary::tables`] ([`eta_node`], [`m_node`]: 25 x 25 per

@@ -1,4 +1,4 @@
-//! The models of the project behind one interface (DESIGN.md 4.7): the Paper
+//! The models of the project behind one interface (docs/design.md 4.7): the Paper
 //! BSDF, the reduced multilayer model, the Lambertian + rough glass baseline
 //! and the rough dielectric alone, each a [`Bsdf`] whose components can be
 //! evaluated one by one ([`ComponentModel`]). Parameter files name them
@@ -179,6 +179,24 @@ pub trait ComponentModel: Bsdf {
     fn is_rgb(&self) -> bool;
     /// The components this model has, in the order of [`Component::ALL`].
     fn components(&self) -> &'static [Component];
+    /// The model's curves in plots: a legend label and the components its curve
+    /// sums. By default one curve per component of [`ComponentModel::components`],
+    /// labelled by [`Component::name`]; `lambert-glass` draws its glass
+    /// (surface reflection and clear transmission) as one curve.
+    fn legend(&self) -> Vec<(&'static str, ComponentSet)> {
+        self.components()
+            .iter()
+            .map(|&c| (c.name(), ComponentSet::only(c)))
+            .collect()
+    }
+    /// The sum of the components in `set` (each by [`ComponentModel::eval_component`],
+    /// in the order of [`Component::ALL`]), without cosine.
+    fn eval_set(&self, wi: DVec3, wo: DVec3, set: ComponentSet) -> Rgb {
+        Component::ALL
+            .into_iter()
+            .filter(|&c| set.contains(c))
+            .fold(Rgb::ZERO, |sum, c| sum + self.eval_component(wi, wo, c))
+    }
 }
 
 impl ComponentModel for PaperBsdf {
@@ -459,6 +477,17 @@ impl ComponentModel for LambertGlass {
     }
     fn components(&self) -> &'static [Component] {
         &[Component::Surface, Component::Multiple, Component::Direct]
+    }
+    /// `lambert` (the Lambertian body, [`Component::Multiple`]) and `rough glass`
+    /// (the glass: its surface reflection and its clear transmission).
+    fn legend(&self) -> Vec<(&'static str, ComponentSet)> {
+        vec![
+            ("lambert", ComponentSet::only(Component::Multiple)),
+            (
+                "rough glass",
+                ComponentSet::only(Component::Surface).with(Component::Direct),
+            ),
+        ]
     }
 }
 

@@ -1,4 +1,4 @@
-//! Parameter errors and range checks shared by every model (DESIGN.md section 3).
+//! Parameter errors and range checks shared by every model (docs/design.md section 3).
 //!
 //! A value outside its range is an error that names the parameter, the value
 //! and the allowed range; nothing is clamped silently.
@@ -106,7 +106,7 @@ impl ParamError {
 use crate::microfacet::Distribution;
 
 /// A parameter that may vary with wavelength: a number or an RGB triple
-/// (DESIGN.md section 2). Serialises as a number or a 3-array; anything else
+/// (docs/design.md section 2). Serialises as a number or a 3-array; anything else
 /// (an array of another length, a string) is an error saying which forms are
 /// accepted.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -183,7 +183,7 @@ impl Colour {
     }
 }
 
-/// Parameters of the Paper BSDF (DESIGN.md section 3, supplement Table 2).
+/// Parameters of the Paper BSDF (docs/design.md section 3, supplement Table 2).
 /// Lengths in mm, coefficients in 1/mm.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -221,7 +221,7 @@ pub struct PaperParams {
     pub face_scattering: FaceScattering,
 }
 
-/// The faces' microfacet scattering (DESIGN.md 4.1, parameter `face_scattering`).
+/// The faces' microfacet scattering (docs/design.md 4.1, parameter `face_scattering`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum FaceScattering {
@@ -261,7 +261,7 @@ impl std::str::FromStr for FaceScattering {
 pub const D_MIN: f64 = 1e-6;
 
 impl PaperParams {
-    /// Checks every parameter against DESIGN.md's ranges; the first violation is returned.
+    /// Checks every parameter against docs/design.md's ranges; the first violation is returned.
     pub fn validate(&self) -> Result<(), ParamError> {
         let pi2 = std::f64::consts::FRAC_PI_2;
         ParamError::check_range("d", self.d, D_MIN, f64::INFINITY)?;

@@ -1,5 +1,5 @@
 //! Phase functions: Henyey-Greenstein and the Paper BSDF's two-lobe mixture
-//! (DESIGN.md 4.2): `p(cos) = w_b HG(cos; g_b) + (1 - w_b) HG(cos; g_f)`, each
+//! (docs/design.md 4.2): `p(cos) = w_b HG(cos; g_b) + (1 - w_b) HG(cos; g_f)`, each
 //! lobe normalised over the sphere. `cos` is the cosine between the propagation
 //! directions before and after scattering (positive `g` scatters forward).
 //!

@@ -1,6 +1,6 @@
 //! The physical sheet that both the Paper BSDF (`crate::paper`) and the
 //! ground-truth simulator (crate `paperbsdf-sim`) describe, decoded once from
-//! [`PaperParams`] (DESIGN.md sections 3, 4.1 and 6).
+//! [`PaperParams`] (docs/design.md sections 3, 4.1 and 6).
 //!
 //! **What the parameters stand for.** A laterally infinite slab of thickness
 //! `d` (front face `z = 0`, back face `z = -d`) of a homogeneous medium

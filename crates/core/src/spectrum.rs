@@ -1,6 +1,6 @@
 //! RGB values of a BSDF.
 //!
-//! Every quantity that may vary with wavelength (DESIGN.md section 2) is carried
+//! Every quantity that may vary with wavelength (docs/design.md section 2) is carried
 //! as three channels. A scalar parameter is stored as three equal channels; the
 //! parameter types remember whether they were given as a scalar so that output
 //! can print one `f` column or `r,g,b` columns.

@@ -1,5 +1,5 @@
 //! Energy, reciprocity, limits and robustness of every model over random
-//! parameters within the full ranges of DESIGN.md section 3 (unequal faces,
+//! parameters within the full ranges of docs/design.md section 3 (unequal faces,
 //! coatings, thin sheets, weak scattering, `g` near +-1, `m` near 0, both
 //! face modes).
 //!

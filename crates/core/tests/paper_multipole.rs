@@ -163,7 +163,7 @@ fn no_absorption_conserves_source_flux() {
 }
 
 /// The model's source depth keeps `R_d`, `T_d` non-negative where the
-/// dipole depth `1/sigma_t'` lies below the slab (DESIGN.md 4.5).
+/// dipole depth `1/sigma_t'` lies below the slab (docs/design.md 4.5).
 #[test]
 fn thin_sheets_never_negative() {
     for d in [1e-6, 1e-3, 0.01, 0.1] {

@@ -1,5 +1,5 @@
 //! The Paper BSDF against the brute-force slab of `reference/` (Mitsuba 3's
-//! volumetric path tracer, DESIGN.md section 6): the model is an
+//! volumetric path tracer, docs/design.md section 6): the model is an
 //! approximation, so this pins its measured accuracy rather than agreement.
 //! At the time of writing the root-mean-square of `ln((f_model + e) /
 //! (f_ref + e))` with `e = 1e-3` over all in-plane points was 0.124 (devA,

@@ -7,7 +7,7 @@
 //! in (weight `1 - F`), first collision within the slab, HG scattering,
 //! attenuation to the exit face, refract out (weight `1 - F` at the inside
 //! angle, zero beyond the critical angle). The simulation counts flux, the
-//! model radiance: agreement checks the `1/eta^2` of DESIGN.md 4.4. Faces of
+//! model radiance: agreement checks the `1/eta^2` of docs/design.md 4.4. Faces of
 //! unequal index are the physical sheet of `paperbsdf_core::sheet`: a base of
 //! index `eta_b` under a thin front coating of index `eta_f`, whose two smooth
 //! boundaries (air/coating, coating/base) the simulation crosses with their
@@ -255,7 +255,7 @@ fn reduced_multilayer_is_paper_with_att_one() {
 
 /// The Paper BSDF's multiple scattering in the multipole normalisation
 /// (energy bound off, Walter's faces) is
-/// `kappa Att(wi) R_d Att(wo) / (pi eta^2 (1 - rho_in))` (DESIGN.md 4.5),
+/// `kappa Att(wi) R_d Att(wo) / (pi eta^2 (1 - rho_in))` (docs/design.md 4.5),
 /// with `rho_in` from the boundary's own integrals, and in transmission the
 /// mean of both faces of entry (reciprocity). The model writes
 /// `eta^2 Tbar_in` as `Abar` (the same by reciprocity of the face's

@@ -5,7 +5,7 @@ use paperbsdf_fit::dataset::load_dataset;
 use paperbsdf_fit::models::candidates;
 use paperbsdf_fit::{fit, FitOptions};
 
-fn main() -> Result<(), String> {
+fn main() -> Result<(), paperbsdf_fit::FitError> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let (files, models): (Vec<String>, Vec<String>) = args.into_iter().partition(|a| a.ends_with(".csv"));
     let models = if models.is_empty() {
@@ -23,7 +23,7 @@ fn main() -> Result<(), String> {
             };
             let t0 = std::time::Instant::now();
             let cpu0 = cpu_seconds();
-            let o = fit(&ds.points, ds.channels, &c, &opts).map_err(|e| e.to_string())?;
+            let o = fit(&ds.points, ds.channels, &c, &opts)?;
             println!(
                 "{f} {m}: rms {:.4} extrap {:.4} points {}+{} evaluations {} wall {:.2} s cpu {:.2} s ({})",
                 o.rms_log_error,

@@ -1,6 +1,7 @@
 //! One or more measurement files fitted together: their points, channel
 //! count and thickness (from the command line or the files' headers).
 
+use crate::error::FitError;
 use crate::measurement::{read_measurement, Point};
 
 /// Points of one or more measurement files.
@@ -19,13 +20,13 @@ pub struct Dataset {
 }
 
 /// Reads `paths`; `thickness` (mm) overrides the headers' thickness.
-pub fn load_dataset(paths: &[String], thickness: Option<f64>) -> Result<Dataset, String> {
+pub fn load_dataset(paths: &[String], thickness: Option<f64>) -> Result<Dataset, FitError> {
     if paths.is_empty() {
-        return Err("no measurement files given".into());
+        return Err(FitError::NoFiles);
     }
     if let Some(d) = thickness {
         if !(d > 0.0 && d.is_finite()) {
-            return Err(format!("--thickness {d} is outside its allowed range (0, inf) mm"));
+            return Err(FitError::ThicknessFlag(d));
         }
     }
     let mut ds = Dataset {
@@ -37,21 +38,26 @@ pub fn load_dataset(paths: &[String], thickness: Option<f64>) -> Result<Dataset,
     };
     let mut header_d: Option<(f64, String)> = None;
     for p in paths {
-        let m = read_measurement(p).map_err(|e| e.to_string())?;
+        let m = read_measurement(p)?;
         let ch = if m.is_rgb { 3 } else { 1 };
         if ds.channels != 0 && ds.channels != ch {
-            return Err(format!(
-                "{p}: has {ch} channel(s) but {} has {}",
-                ds.origins[0], ds.channels
-            ));
+            return Err(FitError::ChannelMismatch {
+                file: p.clone(),
+                channels: ch,
+                first: ds.origins[0].clone(),
+                first_channels: ds.channels,
+            });
         }
         ds.channels = ch;
         if let Some(d) = m.thickness {
             match &header_d {
                 Some((d0, f0)) if (d0 - d).abs() > 1e-12 && thickness.is_none() => {
-                    return Err(format!(
-                        "{p}: thickness {d} mm differs from {d0} mm in {f0}; pass --thickness"
-                    ));
+                    return Err(FitError::ThicknessMismatch {
+                        file: p.clone(),
+                        d,
+                        first: f0.clone(),
+                        first_d: *d0,
+                    });
                 }
                 None => header_d = Some((d, p.clone())),
                 _ => {}

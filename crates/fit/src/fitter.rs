@@ -2,10 +2,11 @@
 //! every discrete variant of the model globally (the default start plus a
 //! Latin hypercube sample of the box), refine the best starts
 //! locally (in parallel with rayon), and score the winner on both point sets
-//! and per incident angle and kind (DESIGN.md section 5).
+//! and per incident angle and kind (docs/design.md section 5).
 
+pub use crate::error::FitError;
 use crate::measurement::{Kind, Point};
-use crate::model::{Evaluable, FitModel};
+use crate::model::{ComponentModel, FitModel};
 use crate::objective::{residuals, rms_log_error, sqrt_weights};
 use crate::optimize::{levenberg_marquardt, LmSettings, Stop};
 use crate::report::{check_data, identifiability, Identifiability, ReportSettings, MEANINGLESS_RMS};
@@ -111,42 +112,6 @@ pub struct FitOutcome {
     pub warnings: Vec<String>,
 }
 
-/// Why a fit failed.
-#[derive(Debug, thiserror::Error)]
-pub enum FitError {
-    /// Nothing to fit.
-    #[error("no measurement points to fit{0}")]
-    NoPoints(String),
-    /// The local refinement did not converge within its budget.
-    #[error("the fit did not converge: the best refinement ({variant}) stopped after {iterations} iterations without meeting the tolerance (RMS log error so far {rms:.4e}); raise the iteration limit")]
-    NotConverged {
-        /// Variant of the best refinement.
-        variant: String,
-        /// Iterations used.
-        iterations: usize,
-        /// Error reached.
-        rms: f64,
-    },
-    /// The data cannot determine the parameters (too few values, no signal, no weight).
-    #[error("the data cannot determine a fit: {0}")]
-    Degenerate(String),
-    /// The best fit misses the data so badly that its parameters mean nothing.
-    #[error("the best fit ({variant}) misses the data by a factor {factor:.3e} on average (RMS log error {rms:.3}, above {limit}): the model cannot represent these data, so no parameters are written. Check the units (f without the cosine, 1/sr) and the values")]
-    Meaningless {
-        /// Variant of the best fit.
-        variant: String,
-        /// Its RMS log error.
-        rms: f64,
-        /// exp(rms).
-        factor: f64,
-        /// The limit [`crate::report::MEANINGLESS_RMS`].
-        limit: f64,
-    },
-    /// The model could not be evaluated anywhere.
-    #[error("the model could not be evaluated at any starting point: {0}")]
-    NoValidStart(String),
-}
-
 fn matches_theta(t: f64, list: &[f64]) -> bool {
     list.iter().any(|x| (x - t).abs() < 1e-6)
 }
@@ -161,7 +126,7 @@ pub fn split_points<'a>(points: &'a [Point], fit_theta_i: Option<&[f64]>) -> (Ve
 
 /// Scores `model` per incident angle and kind.
 pub fn group_errors(
-    model: &dyn Evaluable,
+    model: &dyn ComponentModel,
     points: &[Point],
     fit_theta_i: Option<&[f64]>,
     channels: usize,
@@ -204,7 +169,7 @@ pub fn fit(
         return Err(FitError::NoPoints(why));
     }
     let free = candidates.iter().map(|c| c.specs().len()).max().unwrap_or(0);
-    check_data(&fitted, channels, free).map_err(FitError::Degenerate)?;
+    check_data(&fitted, channels, free)?;
     let sw = sqrt_weights(&fitted, channels);
     let m = sw.len();
     let resid_for = |c: &dyn FitModel, u: &[f64], out: &mut [f64]| -> bool {
@@ -274,7 +239,7 @@ pub fn fit(
         let why = c
             .build(&c.values(&c.default_unit()))
             .err()
-            .unwrap_or_else(|| "non-finite values".into());
+            .map_or_else(|| "non-finite values".to_string(), |e| e.to_string());
         return Err(FitError::NoValidStart(why));
     }
     // The best of each variant, then the overall best, up to `local_starts` (at least one per variant).
@@ -365,7 +330,7 @@ pub fn fit(
         });
     }
     let x = c.values(&best.u);
-    let model = c.build(&x).map_err(FitError::NoValidStart)?;
+    let model = c.build(&x).map_err(|e| FitError::NoValidStart(e.to_string()))?;
     let (rms, rms_u) = rms_log_error(model.as_ref(), &fitted, channels).unwrap();
     let extra_rms = rms_log_error(model.as_ref(), &extra, channels).map(|e| e.0);
     if rms.is_nan() || rms > MEANINGLESS_RMS {

@@ -1,7 +1,7 @@
 //! # paperbsdf-fit
 //!
 //! Fitting BSDF models to in-plane (or general) BSDF measurements, as in
-//! sections 5 to 7 of the Paper BSDF supplement and DESIGN.md section 5:
+//! sections 5 to 7 of the Paper BSDF supplement and docs/design.md section 5:
 //!
 //! * [`measurement`]: the measurement files' reader of [`paperbsdf_io::measurement`],
 //!   re-exported (errors name the file, line and column);
@@ -13,12 +13,14 @@
 //! * [`measured`]: sampling a measured `.bsdf` file, goniometer filters, measured albedo;
 //! * [`report`]: what the data determine (each parameter's interval within the model's
 //!   own error, from profile refits; noise standard errors; bounds) and degenerate-data checks;
+//! * [`error`]: the crate's error type [`FitError`];
 //! * [`fitter`]: global multi-start search plus local refinement, scoring of
 //!   fitted and extrapolation points.
 
 #![warn(missing_docs)]
 
 pub mod dataset;
+pub mod error;
 pub mod fitter;
 pub mod measured;
 pub mod measurement;
@@ -28,6 +30,7 @@ pub mod objective;
 pub mod optimize;
 pub mod report;
 
-pub use fitter::{fit, FitError, FitOptions, FitOutcome, GroupError};
+pub use error::FitError;
+pub use fitter::{fit, FitOptions, FitOutcome, GroupError};
 pub use measurement::{parse_measurement, read_measurement, Kind, Measurement, MeasurementError, Point};
-pub use model::{fix_params, parse_fix, Evaluable, FitModel, ParamSpec, Scale, Subset};
+pub use model::{fix_params, parse_fix, ComponentModel, FitModel, ParamSpec, Scale, Subset};

@@ -6,7 +6,7 @@
 //!
 //! The default set of pairs ([`Sampling::default`]): the light at
 //! `theta_i` = 0, 15, 30, 45, 60, 75 degrees in the x-z plane (`+x` side, as
-//! the in-plane convention of DESIGN.md section 2); for each, the in-plane
+//! the in-plane convention of docs/design.md section 2); for each, the in-plane
 //! viewers `theta_o` = -85 to 85 in steps of 5 (35 points), and out of the
 //! plane the viewers at polar angles 5 to 85 in steps of 10 and azimuths 30 to
 //! 150 in steps of 30 degrees from the light's plane (45 points): 480 pairs.
@@ -15,6 +15,7 @@
 //! Values are [`paperbsdf_core::Bsdf::eval`] of the file (negative ringing of the
 //! stored representation set to zero).
 
+use crate::error::FitError;
 use crate::measurement::{Kind, Point};
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::{Bsdf, DVec3, Rgb};
@@ -61,17 +62,15 @@ pub struct PointFilter {
 
 impl PointFilter {
     /// Checks the ranges: `--exclude-retro` in [0, 180), `--max-theta` in (0, 90].
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), FitError> {
         if let Some(r) = self.exclude_retro_deg {
             if !(0.0..180.0).contains(&r) {
-                return Err(format!(
-                    "--exclude-retro {r} is outside its allowed range [0, 180) degrees"
-                ));
+                return Err(FitError::ExcludeRetro(r));
             }
         }
         if let Some(m) = self.max_theta_deg {
             if !(m > 0.0 && m <= 90.0) {
-                return Err(format!("--max-theta {m} is outside its allowed range (0, 90] degrees"));
+                return Err(FitError::MaxTheta(m));
             }
         }
         Ok(())
@@ -124,7 +123,7 @@ pub fn sample_measured(b: &MeasuredBsdf, s: &Sampling) -> Vec<Point> {
 }
 
 /// In-plane slices of `b`: reflection points at every incident angle of
-/// `theta_i` and signed viewing angle of `theta_o` (degrees, DESIGN.md
+/// `theta_i` and signed viewing angle of `theta_o` (degrees, docs/design.md
 /// section 2) that `filter` keeps, in that order; what `paperbsdf convert`
 /// writes and `paperbsdf plot` draws for a `.bsdf` file.
 pub fn sample_in_plane(b: &MeasuredBsdf, theta_i: &[f64], theta_o: &[f64], filter: &PointFilter) -> Vec<Point> {

@@ -1,6 +1,7 @@
 //! What the fitter needs of a model: named parameters with search bounds, a
-//! way to build an evaluable BSDF from a parameter vector, the parameter file
-//! that vector corresponds to, and the model's components for the plots.
+//! way to build the model from a parameter vector (as core's
+//! [`ComponentModel`], which also gives the components for the plots) and the
+//! parameter file that vector corresponds to.
 //!
 //! The search works in the unit cube: each parameter has a [`Scale`] that maps
 //! `u` in [0, 1] to its value (linear, or logarithmic for quantities that span
@@ -8,7 +9,8 @@
 //! supplement's Table 2 made finite where Table 2 says infinity (see each
 //! model's documentation for the numbers).
 
-use paperbsdf_core::{DVec3, Rgb};
+use crate::error::FitError;
+pub use paperbsdf_core::models::ComponentModel;
 
 /// How a parameter's value depends on its unit-cube coordinate `u`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,17 +65,6 @@ impl ParamSpec {
     }
 }
 
-/// A model built from one parameter vector: its BSDF and its components.
-pub trait Evaluable: Send + Sync {
-    /// `f(wi, wo)` without cosine (the sum of the components).
-    fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb;
-    /// Names of the components, in plotting order (e.g. `surface`, `single`,
-    /// `multiple`, `direct`; `lambert`, `rough glass`).
-    fn component_names(&self) -> Vec<&'static str>;
-    /// `f` of component `index` of [`Evaluable::component_names`].
-    fn eval_component(&self, index: usize, wi: DVec3, wo: DVec3) -> Rgb;
-}
-
 /// A model family the fitter can search: one instance per discrete choice
 /// (e.g. the microfacet distribution of each face).
 pub trait FitModel: Send + Sync {
@@ -84,7 +75,7 @@ pub trait FitModel: Send + Sync {
     /// The fitted parameters.
     fn specs(&self) -> &[ParamSpec];
     /// Builds the model from parameter values (not unit coordinates).
-    fn build(&self, x: &[f64]) -> Result<Box<dyn Evaluable>, String>;
+    fn build(&self, x: &[f64]) -> Result<Box<dyn ComponentModel>, FitError>;
     /// The parameter file of these values (JSON object with the model's keys).
     fn params_json(&self, x: &[f64]) -> serde_json::Value;
     /// The values at unit coordinates `u`.
@@ -109,14 +100,17 @@ pub struct Subset {
 impl Subset {
     /// `inner` with every parameter not named in `free` held at its value in `base`.
     /// Unknown names are an error.
-    pub fn new(inner: Box<dyn FitModel>, free: &[&str], base: Vec<f64>) -> Result<Subset, String> {
+    pub fn new(inner: Box<dyn FitModel>, free: &[&str], base: Vec<f64>) -> Result<Subset, FitError> {
         let mut idx = Vec::new();
         for f in free {
             let i = inner
                 .specs()
                 .iter()
                 .position(|s| s.name == *f)
-                .ok_or_else(|| format!("model `{}` has no parameter `{f}`", inner.model_name()))?;
+                .ok_or_else(|| FitError::UnknownParameter {
+                    model: inner.model_name().to_string(),
+                    name: f.to_string(),
+                })?;
             idx.push(i);
         }
         let specs = idx.iter().map(|&i| inner.specs()[i].clone()).collect();
@@ -146,7 +140,7 @@ impl FitModel for Subset {
     fn specs(&self) -> &[ParamSpec] {
         &self.specs
     }
-    fn build(&self, x: &[f64]) -> Result<Box<dyn Evaluable>, String> {
+    fn build(&self, x: &[f64]) -> Result<Box<dyn ComponentModel>, FitError> {
         self.inner.build(&self.full(x))
     }
     fn params_json(&self, x: &[f64]) -> serde_json::Value {
@@ -155,16 +149,14 @@ impl FitModel for Subset {
 }
 
 /// Parses `NAME=VALUE` (the `--fix` option).
-pub fn parse_fix(s: &str) -> Result<(String, f64), String> {
-    let (n, v) = s
-        .split_once('=')
-        .ok_or_else(|| format!("--fix `{s}`: expected NAME=VALUE, e.g. --fix eta_f=1.5"))?;
-    let v: f64 = v
-        .trim()
-        .parse()
-        .map_err(|_| format!("--fix `{s}`: `{}` is not a number", v.trim()))?;
+pub fn parse_fix(s: &str) -> Result<(String, f64), FitError> {
+    let (n, v) = s.split_once('=').ok_or_else(|| FitError::FixSyntax(s.to_string()))?;
+    let v: f64 = v.trim().parse().map_err(|_| FitError::FixNotNumber {
+        arg: s.to_string(),
+        value: v.trim().to_string(),
+    })?;
     if !v.is_finite() {
-        return Err(format!("--fix `{s}`: the value must be finite"));
+        return Err(FitError::FixNotFinite(s.to_string()));
     }
     Ok((n.trim().to_string(), v))
 }
@@ -174,7 +166,7 @@ pub fn parse_fix(s: &str) -> Result<(String, f64), String> {
 /// parameters, all three channels (`sigma_a` fixes `sigma_a[0]`..`sigma_a[2]`).
 /// Errors name an unknown parameter (listing the known ones), a value the model
 /// refuses (with the model's reason), or a fit with nothing left free.
-pub fn fix_params(cands: Vec<Box<dyn FitModel>>, fixes: &[(String, f64)]) -> Result<Vec<Box<dyn FitModel>>, String> {
+pub fn fix_params(cands: Vec<Box<dyn FitModel>>, fixes: &[(String, f64)]) -> Result<Vec<Box<dyn FitModel>>, FitError> {
     if fixes.is_empty() {
         return Ok(cands);
     }
@@ -198,15 +190,16 @@ pub fn fix_params(cands: Vec<Box<dyn FitModel>>, fixes: &[(String, f64)]) -> Res
                     .map(|s| s.name.split('[').next().unwrap_or("").to_string())
                     .collect();
                 names.dedup();
-                return Err(format!(
-                    "--fix {name}={v}: model `{}` has no fitted parameter `{name}` (fitted parameters: {}; the thickness is --thickness)",
-                    c.model_name(),
-                    names.join(", ")
-                ));
+                return Err(FitError::FixUnknown {
+                    name: name.clone(),
+                    value: *v,
+                    model: c.model_name().to_string(),
+                    known: names.join(", "),
+                });
             }
         }
         if let Err(e) = c.build(&base) {
-            return Err(format!("--fix: the model refuses the fixed values: {e}"));
+            return Err(FitError::FixRefused(Box::new(e)));
         }
         let free: Vec<String> = specs
             .iter()
@@ -215,7 +208,7 @@ pub fn fix_params(cands: Vec<Box<dyn FitModel>>, fixes: &[(String, f64)]) -> Res
             .map(|(s, _)| s.name.clone())
             .collect();
         if free.is_empty() {
-            return Err("--fix holds every parameter: nothing is left to fit".into());
+            return Err(FitError::FixAll);
         }
         let free_refs: Vec<&str> = free.iter().map(|s| s.as_str()).collect();
         out.push(Box::new(Subset::new(c, &free_refs, base)?));

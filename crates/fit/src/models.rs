@@ -1,5 +1,5 @@
 //! The models the fitter knows, as [`FitModel`]s: `paper` (the Paper BSDF,
-//! DESIGN.md section 4), `reduced-multilayer` (the Paper BSDF without the
+//! docs/design.md section 4), `reduced-multilayer` (the Paper BSDF without the
 //! attenuation term, section 4.7) and `lambert-glass` (Lambertian reflection
 //! and transmission plus a rough dielectric, section 4.7).
 //!
@@ -19,7 +19,7 @@
 //! The index range is narrower than Table 2's (1, 5]: paper's cellulose, fillers
 //! and coatings have indices of 1.5 to 2, and a box that is mostly unphysical
 //! makes the global search slower. `d` is not fitted (the paper measured it). Index-matched (`eta = 1`) and
-//! smooth (`m = 0`) faces are not searched (DESIGN.md section 3). Each
+//! smooth (`m = 0`) faces are not searched (docs/design.md section 3). Each
 //! microfacet distribution choice (`ggx` or `beckmann`, per face) is a
 //! separate variant; the fitter tries every variant and keeps the best.
 //! With RGB data `sigma_a`, `sigma_s` (and `k_d`, `k_t`) are fitted per channel.
@@ -27,20 +27,17 @@
 //! and the fraction `k_t / (1 - k_d)` of what is left, so that every point of
 //! the box is a valid model.
 
-use crate::model::{Evaluable, FitModel, ParamSpec, Scale};
-use paperbsdf_core::models::{ComponentModel, LambertGlass, LambertGlassParams, ModelKind};
-use paperbsdf_core::paper::{Component, PaperBsdf};
-use paperbsdf_core::{Bsdf, Colour, DVec3, Distribution, FaceScattering, PaperParams, Rgb};
+use crate::error::FitError;
+use crate::model::{ComponentModel, FitModel, ParamSpec, Scale};
+use paperbsdf_core::models::{LambertGlass, LambertGlassParams, ModelKind, ModelParams};
+use paperbsdf_core::{Colour, Distribution, FaceScattering, PaperParams};
 
 /// The model named `name` if the fitter can fit it; else the error lists the
 /// models it can fit.
-fn fittable(name: &str) -> Result<ModelKind, String> {
+fn fittable(name: &str) -> Result<ModelKind, FitError> {
     match name.parse::<ModelKind>() {
         Ok(k) if k.is_fittable() => Ok(k),
-        _ => Err(format!(
-            "unknown model `{name}` for fitting; models that can be fitted: {}",
-            ModelKind::list(ModelKind::fittable())
-        )),
+        _ => Err(FitError::UnknownModel { name: name.to_string() }),
     }
 }
 
@@ -135,38 +132,6 @@ impl PaperFit {
     }
 }
 
-/// A built Paper BSDF as an [`Evaluable`] with its four components.
-pub struct PaperEval(pub PaperBsdf);
-
-const PAPER_COMPONENTS: [Component; 4] = [
-    Component::Surface,
-    Component::Single,
-    Component::Multiple,
-    Component::Direct,
-];
-
-impl Evaluable for PaperEval {
-    fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
-        self.0.eval(wi, wo)
-    }
-    fn component_names(&self) -> Vec<&'static str> {
-        vec!["surface", "single", "multiple", "direct"]
-    }
-    fn eval_component(&self, index: usize, wi: DVec3, wo: DVec3) -> Rgb {
-        self.0.eval_component(wi, wo, PAPER_COMPONENTS[index])
-    }
-}
-
-/// Builds the Paper BSDF (or the reduced multilayer model) from a parameter set.
-pub fn build_paper(p: &PaperParams, reduced: bool) -> Result<PaperEval, String> {
-    let b = if reduced {
-        PaperBsdf::reduced_multilayer(p)
-    } else {
-        PaperBsdf::new(p)
-    };
-    b.map(PaperEval).map_err(|e| e.to_string())
-}
-
 impl FitModel for PaperFit {
     fn model_name(&self) -> &str {
         if self.reduced {
@@ -181,8 +146,13 @@ impl FitModel for PaperFit {
     fn specs(&self) -> &[ParamSpec] {
         &self.specs
     }
-    fn build(&self, x: &[f64]) -> Result<Box<dyn Evaluable>, String> {
-        Ok(Box::new(build_paper(&self.params(x), self.reduced)?))
+    fn build(&self, x: &[f64]) -> Result<Box<dyn ComponentModel>, FitError> {
+        let kind = if self.reduced {
+            ModelKind::ReducedMultilayer
+        } else {
+            ModelKind::Paper
+        };
+        Ok(kind.build(&ModelParams::Slab(self.params(x)))?)
     }
     fn params_json(&self, x: &[f64]) -> serde_json::Value {
         let p = self.params(x);
@@ -225,27 +195,6 @@ impl LambertGlassFit {
     }
 }
 
-/// A built Lambert + rough glass model with components `lambert` and `rough glass`.
-pub struct LambertGlassEval(pub LambertGlass);
-
-impl Evaluable for LambertGlassEval {
-    fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
-        self.0.eval(wi, wo)
-    }
-    fn component_names(&self) -> Vec<&'static str> {
-        vec!["lambert", "rough glass"]
-    }
-    fn eval_component(&self, index: usize, wi: DVec3, wo: DVec3) -> Rgb {
-        // The Lambertian terms are the model's `Multiple` component; the glass is
-        // its surface reflection and its clear (direct) transmission.
-        if index == 0 {
-            self.0.eval_component(wi, wo, Component::Multiple)
-        } else {
-            self.0.eval_component(wi, wo, Component::Surface) + self.0.eval_component(wi, wo, Component::Direct)
-        }
-    }
-}
-
 impl FitModel for LambertGlassFit {
     fn model_name(&self) -> &str {
         ModelKind::LambertGlass.name()
@@ -256,10 +205,8 @@ impl FitModel for LambertGlassFit {
     fn specs(&self) -> &[ParamSpec] {
         &self.specs
     }
-    fn build(&self, x: &[f64]) -> Result<Box<dyn Evaluable>, String> {
-        LambertGlass::new(&self.params(x))
-            .map(|b| Box::new(LambertGlassEval(b)) as Box<dyn Evaluable>)
-            .map_err(|e| e.to_string())
+    fn build(&self, x: &[f64]) -> Result<Box<dyn ComponentModel>, FitError> {
+        Ok(Box::new(LambertGlass::new(&self.params(x))?))
     }
     fn params_json(&self, x: &[f64]) -> serde_json::Value {
         let p = self.params(x);
@@ -275,7 +222,7 @@ pub fn candidates(
     d: Option<f64>,
     rgb: bool,
     dists: Option<&[Distribution]>,
-) -> Result<Vec<Box<dyn FitModel>>, String> {
+) -> Result<Vec<Box<dyn FitModel>>, FitError> {
     candidates_with_faces(name, d, rgb, dists, FaceScattering::default())
 }
 
@@ -287,15 +234,13 @@ pub fn candidates_with_faces(
     rgb: bool,
     dists: Option<&[Distribution]>,
     face_scattering: FaceScattering,
-) -> Result<Vec<Box<dyn FitModel>>, String> {
+) -> Result<Vec<Box<dyn FitModel>>, FitError> {
     let ds: Vec<Distribution> = dists.map(|d| d.to_vec()).unwrap_or_else(|| DISTS.to_vec());
     match fittable(name)? {
         kind @ (ModelKind::Paper | ModelKind::ReducedMultilayer) => {
-            let d = d.ok_or_else(|| {
-                format!("model `{name}` needs the paper's thickness d: pass --thickness D (mm) or give the data a `# thickness: D` or `# params: {{\"d\": D, ...}}` header")
-            })?;
+            let d = d.ok_or_else(|| FitError::NeedsThickness(name.to_string()))?;
             if !(d > 0.0 && d.is_finite()) {
-                return Err(format!("thickness d = {d} is outside its allowed range (0, inf) mm"));
+                return Err(FitError::Thickness(d));
             }
             let mut v: Vec<Box<dyn FitModel>> = Vec::new();
             for &f in &ds {
@@ -317,20 +262,16 @@ pub fn candidates_with_faces(
 }
 
 /// Builds model `name` from a parameter set (the `params` of a FIT.json).
-pub fn build_from_params(name: &str, params: &serde_json::Value) -> Result<Box<dyn Evaluable>, String> {
-    match fittable(name)? {
-        kind @ (ModelKind::Paper | ModelKind::ReducedMultilayer) => {
-            let p: PaperParams =
-                serde_json::from_value(params.clone()).map_err(|e| format!("params of `{name}`: {e}"))?;
-            Ok(Box::new(build_paper(&p, kind == ModelKind::ReducedMultilayer)?))
-        }
-        ModelKind::LambertGlass => {
-            let p: LambertGlassParams =
-                serde_json::from_value(params.clone()).map_err(|e| format!("params of `{name}`: {e}"))?;
-            Ok(Box::new(LambertGlassEval(
-                LambertGlass::new(&p).map_err(|e| e.to_string())?,
-            )))
-        }
-        k => unreachable!("fittable() returned {k}"),
-    }
+pub fn build_from_params(name: &str, params: &serde_json::Value) -> Result<Box<dyn ComponentModel>, FitError> {
+    let json_error = |source| FitError::ParamsJson {
+        model: name.to_string(),
+        source,
+    };
+    let kind = fittable(name)?;
+    let typed = if kind.is_slab() {
+        ModelParams::Slab(serde_json::from_value(params.clone()).map_err(json_error)?)
+    } else {
+        ModelParams::LambertGlass(serde_json::from_value(params.clone()).map_err(json_error)?)
+    };
+    Ok(kind.build(&typed)?)
 }

@@ -1,4 +1,4 @@
-//! The fit error of DESIGN.md section 5: the root mean square of
+//! The fit error of docs/design.md section 5: the root mean square of
 //! `ln((f_model + e) / (f_meas + e))` over all points and channels.
 //!
 //! * `e` = [`LOG_OFFSET`] = 1e-3 (1/sr). Paper's in-plane BSDF values lie
@@ -15,7 +15,7 @@
 //!   scores 0.01 whatever the weights). The unweighted RMS is reported beside it.
 
 use crate::measurement::Point;
-use crate::model::Evaluable;
+use crate::model::ComponentModel;
 
 /// The offset `e` added to model and measurement inside the logarithm (1/sr).
 pub const LOG_OFFSET: f64 = 1e-3;
@@ -42,7 +42,7 @@ pub fn weight(p: &Point, c: usize) -> f64 {
 
 /// Weighted and unweighted RMS log error of `model` over `points`
 /// (`channels` = 1 or 3). `None` when there are no points.
-pub fn rms_log_error(model: &dyn Evaluable, points: &[&Point], channels: usize) -> Option<(f64, f64)> {
+pub fn rms_log_error(model: &dyn ComponentModel, points: &[&Point], channels: usize) -> Option<(f64, f64)> {
     if points.is_empty() {
         return None;
     }
@@ -63,7 +63,13 @@ pub fn rms_log_error(model: &dyn Evaluable, points: &[&Point], channels: usize) 
 
 /// Fills `out` with the residuals `sqrt(w / sum w) r` whose sum of squares is
 /// the squared weighted RMS error. Returns false if a value is not finite.
-pub fn residuals(model: &dyn Evaluable, points: &[&Point], sqrt_w: &[f64], channels: usize, out: &mut [f64]) -> bool {
+pub fn residuals(
+    model: &dyn ComponentModel,
+    points: &[&Point],
+    sqrt_w: &[f64],
+    channels: usize,
+    out: &mut [f64],
+) -> bool {
     let mut k = 0;
     for p in points {
         let f = model.eval(p.wi, p.wo);

@@ -84,6 +84,7 @@
 //! |dx/du|`. It is what the noise of the data alone would allow, given that the
 //! model were exact; it is not the uncertainty of the parameter.
 
+use crate::error::FitError;
 use crate::measurement::Point;
 use crate::model::{FitModel, Scale};
 use crate::objective::residuals;
@@ -386,23 +387,27 @@ pub fn identifiability(
 /// Refuses data that cannot determine a fit: fewer values than free
 /// parameters, no signal (every value zero), or every weight zero. The error
 /// says which.
-pub fn check_data(points: &[&Point], channels: usize, free_params: usize) -> Result<(), String> {
+pub fn check_data(points: &[&Point], channels: usize, free_params: usize) -> Result<(), FitError> {
     let values = points.len() * channels;
     if values < free_params {
-        return Err(format!(
+        return Err(FitError::Degenerate(format!(
             "{} point(s) x {channels} channel(s) = {values} value(s) cannot determine {free_params} free parameters; \
              give more measurements or hold parameters with --fix NAME=VALUE",
             points.len()
-        ));
+        )));
     }
     if points.iter().all(|p| (0..channels).all(|c| p.f.0[c] == 0.0)) {
-        return Err("every measured value is zero: there is no signal to fit".into());
+        return Err(FitError::Degenerate(
+            "every measured value is zero: there is no signal to fit".into(),
+        ));
     }
     if points
         .iter()
         .all(|p| (0..channels).all(|c| crate::objective::weight(p, c) == 0.0))
     {
-        return Err("every point has weight zero: nothing would be fitted".into());
+        return Err(FitError::Degenerate(
+            "every point has weight zero: nothing would be fitted".into(),
+        ));
     }
     Ok(())
 }

@@ -10,10 +10,10 @@
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::Distribution;
 use paperbsdf_fit::models::candidates;
-use paperbsdf_fit::{fit, parse_measurement, Evaluable, FitModel, FitOptions, Point, Subset};
+use paperbsdf_fit::{fit, parse_measurement, ComponentModel, FitModel, FitOptions, Point, Subset};
 use rand::{Rng, SeedableRng};
 
-fn synthetic(model: &dyn Evaluable) -> Vec<Point> {
+fn synthetic(model: &dyn ComponentModel) -> Vec<Point> {
     let mut text = String::from("kind,theta_i_deg,theta_o_deg,f\n");
     for ti in [0.0, 45.0] {
         for k in ["R", "T"] {
@@ -111,9 +111,9 @@ fn lambert_glass_recovers() {
 
 #[test]
 fn paper_needs_thickness() {
-    let e = candidates("paper", None, false, None).err().unwrap();
+    let e = candidates("paper", None, false, None).err().unwrap().to_string();
     assert!(e.contains("--thickness"), "{e}");
-    let e = candidates("papr", Some(0.1), false, None).err().unwrap();
+    let e = candidates("papr", Some(0.1), false, None).err().unwrap().to_string();
     assert!(e.contains("unknown model `papr`"), "{e}");
 }
 

@@ -4,7 +4,7 @@
 //! 1e-3 from the default start, and the bounds, extrapolation split and
 //! non-convergence report behave as documented.
 
-use paperbsdf_core::{DVec3, Distribution, Rgb, RoughDielectric};
+use paperbsdf_core::{Bsdf, BsdfFlags, BsdfSample, Component, DVec3, Distribution, Rgb, RoughDielectric};
 use paperbsdf_fit::*;
 use rand::{Rng, SeedableRng};
 
@@ -19,18 +19,38 @@ struct ToyModel {
     glass: RoughDielectric,
 }
 
-impl Evaluable for ToyModel {
+/// The fitter only evaluates models, so the toy does not sample.
+impl Bsdf for ToyModel {
     fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
-        (0..2).fold(Rgb::ZERO, |a, i| a + self.eval_component(i, wi, wo))
+        self.eval_component(wi, wo, Component::Multiple) + self.eval_component(wi, wo, Component::Surface)
     }
-    fn component_names(&self) -> Vec<&'static str> {
-        vec!["lambert", "rough glass"]
+    fn sample(&self, _wo: DVec3, _uc: f64, _u: [f64; 2]) -> Option<BsdfSample> {
+        None
     }
-    fn eval_component(&self, i: usize, wi: DVec3, wo: DVec3) -> Rgb {
-        match i {
-            0 => Rgb::splat(if wi.z * wo.z > 0.0 { self.k_d } else { self.k_t } / std::f64::consts::PI),
-            _ => Rgb::splat(self.glass.eval_mode(wi, wo, paperbsdf_core::TransportMode::Radiance)),
+    fn pdf(&self, _wi: DVec3, _wo: DVec3) -> f64 {
+        0.0
+    }
+    fn flags(&self) -> BsdfFlags {
+        BsdfFlags::REFLECTION | BsdfFlags::TRANSMISSION | BsdfFlags::DIFFUSE | BsdfFlags::GLOSSY
+    }
+}
+
+/// `lambert` is the `Multiple` component, `rough glass` the `Surface` one.
+impl ComponentModel for ToyModel {
+    fn eval_component(&self, wi: DVec3, wo: DVec3, c: Component) -> Rgb {
+        match c {
+            Component::Multiple => {
+                Rgb::splat(if wi.z * wo.z > 0.0 { self.k_d } else { self.k_t } / std::f64::consts::PI)
+            }
+            Component::Surface => Rgb::splat(self.glass.eval_mode(wi, wo, paperbsdf_core::TransportMode::Radiance)),
+            _ => Rgb::ZERO,
         }
+    }
+    fn is_rgb(&self) -> bool {
+        false
+    }
+    fn components(&self) -> &'static [Component] {
+        &[Component::Surface, Component::Multiple]
     }
 }
 
@@ -58,8 +78,8 @@ impl FitModel for Toy {
     fn specs(&self) -> &[ParamSpec] {
         &self.specs
     }
-    fn build(&self, x: &[f64]) -> Result<Box<dyn Evaluable>, String> {
-        let glass = RoughDielectric::new(self.dist, x[2], x[3]).map_err(|e| e.to_string())?;
+    fn build(&self, x: &[f64]) -> Result<Box<dyn ComponentModel>, FitError> {
+        let glass = RoughDielectric::new(self.dist, x[2], x[3])?;
         Ok(Box::new(ToyModel {
             k_d: x[0],
             k_t: x[1],
@@ -71,7 +91,7 @@ impl FitModel for Toy {
     }
 }
 
-fn synthetic(model: &dyn Evaluable, thetas: &[f64]) -> Vec<Point> {
+fn synthetic(model: &dyn ComponentModel, thetas: &[f64]) -> Vec<Point> {
     let mut text = String::from("kind,theta_i_deg,theta_o_deg,f\n");
     for &ti in thetas {
         for k in ["R", "T"] {
@@ -190,15 +210,29 @@ fn weights_follow_standard_errors() {
     let text = "kind,theta_i_deg,theta_o_deg,f,stderr\nR,0,10,1.0,0.001\nR,0,20,1.0,1.0\n";
     let pts = parse_measurement(text, "w").unwrap().points;
     struct Const;
-    impl Evaluable for Const {
+    impl Bsdf for Const {
         fn eval(&self, _: DVec3, wo: DVec3) -> Rgb {
             Rgb::splat(if wo.x < 0.2 { 1.1 } else { 1.0 })
         }
-        fn component_names(&self) -> Vec<&'static str> {
-            vec![]
+        fn sample(&self, _wo: DVec3, _uc: f64, _u: [f64; 2]) -> Option<BsdfSample> {
+            None
         }
-        fn eval_component(&self, _: usize, wi: DVec3, wo: DVec3) -> Rgb {
-            self.eval(wi, wo)
+        fn pdf(&self, _wi: DVec3, _wo: DVec3) -> f64 {
+            0.0
+        }
+        fn flags(&self) -> BsdfFlags {
+            BsdfFlags::REFLECTION
+        }
+    }
+    impl ComponentModel for Const {
+        fn eval_component(&self, _: DVec3, _: DVec3, _: Component) -> Rgb {
+            Rgb::ZERO
+        }
+        fn is_rgb(&self) -> bool {
+            false
+        }
+        fn components(&self) -> &'static [Component] {
+            &[]
         }
     }
     let refs: Vec<&Point> = pts.iter().collect();

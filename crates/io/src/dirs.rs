@@ -1,6 +1,6 @@
 //! CSV files of direction pairs: columns `wi_x,wi_y,wi_z,wo_x,wo_y,wo_z` (any
 //! order, other columns ignored, `#` lines are comments; read with the `csv`
-//! crate, see [`crate::text::csv_records`]), in the local frame of DESIGN.md
+//! crate, see [`crate::text::csv_records`]), in the local frame of docs/design.md
 //! section 2. Each direction must be finite and of unit length
 //! (to 1e-4); an error names the file, line and field.
 

@@ -1,6 +1,6 @@
 //! # paperbsdf-io
 //!
-//! Reading and writing the project's files in the conventions of DESIGN.md:
+//! Reading and writing the project's files in the conventions of docs/design.md:
 //! parameter files (JSON, TOML or inline JSON) with errors that name the file,
 //! line and parameter; CSV files of direction pairs and of BSDF measurements
 //! ([`measurement`]), with errors that name the file, line and column; atomic

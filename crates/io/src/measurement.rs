@@ -1,6 +1,6 @@
 //! Readers for BSDF measurement files.
 //!
-//! Two CSV layouts, in the conventions of DESIGN.md section 2 (`f` without the
+//! Two CSV layouts, in the conventions of docs/design.md section 2 (`f` without the
 //! cosine factor, `wi` toward the light, `wo` toward the viewer):
 //!
 //! * **in-plane**: columns `kind,theta_i_deg,theta_o_deg` (the layout of

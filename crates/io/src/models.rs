@@ -1,5 +1,5 @@
 //! Models by name, built from a parameter source: the registry that the CLI,
-//! the fitter and the renderer share. Names (DESIGN.md 4.7): `paper`,
+//! the fitter and the renderer share. Names (docs/design.md 4.7): `paper`,
 //! `reduced-multilayer` (same parameters as `paper`), `lambert-glass`,
 //! `rough-dielectric`; and `measured`, whose "parameters" are a measured
 //! RGL `.bsdf` file ([`crate::rgl`]).

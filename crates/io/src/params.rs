@@ -3,7 +3,7 @@
 //! see [`paperbsdf_core::presets`]) when no file of that name exists, or a
 //! FIT.json written by `paperbsdf fit` (its `params` object is used, and error
 //! lines still point into the fit file). Keys are exactly the parameter names
-//! of DESIGN.md section 3 (unknown keys are errors, which catches typos);
+//! of docs/design.md section 3 (unknown keys are errors, which catches typos);
 //! values outside their ranges are errors naming the file, line, parameter,
 //! value and range.
 

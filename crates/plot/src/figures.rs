@@ -6,6 +6,7 @@
 //! extrapolation (grey panels). One figure per model, one row per paper.
 
 use crate::{draw_figure, panels_for, Figure, PlotError, Row};
+use paperbsdf_core::models::ModelKind;
 use paperbsdf_fit::dataset::load_dataset;
 use paperbsdf_fit::models::candidates;
 use paperbsdf_fit::{fit, FitOptions, FitOutcome};
@@ -18,22 +19,22 @@ pub const DEFAULT_FIT_THETA_I: [f64; 3] = [0.0, 30.0, 60.0];
 pub const PAPERS: [&str; 3] = ["matte", "luster", "glossy"];
 
 /// The figures: (number, model, file stem, title).
-pub const FIGURES: [(u32, &str, &str, &str); 3] = [
+pub const FIGURES: [(u32, ModelKind, &str, &str); 3] = [
     (
         3,
-        "paper",
+        ModelKind::Paper,
         "fig3_paper",
         "Paper BSDF fits (analogue of supplement Figure 3)",
     ),
     (
         4,
-        "lambert-glass",
+        ModelKind::LambertGlass,
         "fig4_lambert_glass",
         "Lambertian + rough glass fits (analogue of supplement Figure 4)",
     ),
     (
         5,
-        "reduced-multilayer",
+        ModelKind::ReducedMultilayer,
         "fig5_reduced_multilayer",
         "Reduced multilayer BSDF fits (analogue of supplement Figure 5)",
     ),
@@ -109,7 +110,8 @@ pub fn make_figures(opts: &FiguresOptions) -> Result<Vec<TableRow>, PlotError> {
         source,
     })?;
     let mut table = Vec::new();
-    for (num, model, stem, title) in FIGURES {
+    for (num, kind, stem, title) in FIGURES {
+        let model = kind.name();
         let mut rows = Vec::new();
         for (name, path, in_figure) in &sets {
             let ds = load_dataset(std::slice::from_ref(path), None).map_err(data_error)?;

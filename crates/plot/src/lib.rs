@@ -7,7 +7,7 @@
 //! model's components (surface orange, single scattering cyan, multiple
 //! scattering blue, ...) and their sum in black drawn over them, extrapolated
 //! incident angles (not used in the fit) on a grey background. The horizontal
-//! axis is the signed viewing angle `theta_o` of DESIGN.md section 2 (positive
+//! axis is the signed viewing angle `theta_o` of docs/design.md section 2 (positive
 //! on the light's side); the value axis is linear or logarithmic, with ticks
 //! at round values (1, 2, 5 times a power of ten on a log axis).
 //!

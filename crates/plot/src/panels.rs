@@ -1,12 +1,12 @@
 //! The panels of one paper ([`panels_for`]): per incident angle a BRDF and a
 //! BTDF panel with the measurement (points with standard errors) and a model's
 //! components and sum evaluated at 1-degree steps of the in-plane viewing angle
-//! (`paperbsdf_core::geometry::in_plane_directions`, DESIGN.md section 2), in
+//! (`paperbsdf_core::geometry::in_plane_directions`, docs/design.md section 2), in
 //! the colours of the supplement's figures.
 
 use crate::{Panel, Series, Style};
 use paperbsdf_core::geometry::in_plane_directions;
-use paperbsdf_fit::{Evaluable, Kind, Point};
+use paperbsdf_fit::{ComponentModel, Kind, Point};
 
 /// Colour of the measurement.
 pub const MEASUREMENT: (u8, u8, u8) = (220, 20, 20);
@@ -35,7 +35,7 @@ pub fn curve_angles() -> Vec<f64> {
 /// BRDF and a BTDF panel (when the data have that kind) with the measurement
 /// and, when `model` is given, its components and sum. `fit_theta_i`: the
 /// fitted angles (others are marked extrapolated); `None` marks none.
-pub fn panels_for(points: &[Point], model: Option<&dyn Evaluable>, fit_theta_i: Option<&[f64]>) -> Vec<Panel> {
+pub fn panels_for(points: &[Point], model: Option<&dyn ComponentModel>, fit_theta_i: Option<&[f64]>) -> Vec<Panel> {
     let mut thetas: Vec<f64> = points.iter().map(|p| p.theta_i).collect();
     thetas.sort_by(|a, b| a.partial_cmp(b).unwrap());
     thetas.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
@@ -65,11 +65,11 @@ pub fn panels_for(points: &[Point], model: Option<&dyn Evaluable>, fit_theta_i: 
                     .iter()
                     .map(|&o| in_plane_directions(t, o, kind == Kind::T))
                     .collect();
-                for (ci, name) in m.component_names().iter().enumerate() {
+                for (name, set) in m.legend() {
                     let pts: Vec<(f64, f64)> = angles
                         .iter()
                         .zip(&dirs)
-                        .map(|(&o, &(wi, wo))| (o, m.eval_component(ci, wi, wo).mean()))
+                        .map(|(&o, &(wi, wo))| (o, m.eval_set(wi, wo, set).mean()))
                         .collect();
                     if pts.iter().all(|p| p.1 == 0.0) {
                         continue;

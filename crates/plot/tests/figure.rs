@@ -1,20 +1,40 @@
 //! Figures are drawn with text, the measurement in red, components in their
 //! colours and extrapolated panels on grey; files are PNG or SVG.
 
-use paperbsdf_core::{DVec3, Rgb};
-use paperbsdf_fit::{parse_measurement, Evaluable};
+use paperbsdf_core::{Bsdf, BsdfFlags, BsdfSample, Component, DVec3, Rgb};
+use paperbsdf_fit::{parse_measurement, ComponentModel};
 use paperbsdf_plot::*;
 
+/// A two-component model (a surface peak and a flat body) for the plots; the
+/// figures only evaluate it, so it does not sample.
 struct Two;
-impl Evaluable for Two {
+impl Bsdf for Two {
     fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
-        self.eval_component(0, wi, wo) + self.eval_component(1, wi, wo)
+        self.eval_component(wi, wo, Component::Surface) + self.eval_component(wi, wo, Component::Multiple)
     }
-    fn component_names(&self) -> Vec<&'static str> {
-        vec!["surface", "multiple"]
+    fn sample(&self, _wo: DVec3, _uc: f64, _u: [f64; 2]) -> Option<BsdfSample> {
+        None
     }
-    fn eval_component(&self, i: usize, _wi: DVec3, wo: DVec3) -> Rgb {
-        Rgb::splat(if i == 0 { 0.05 + 0.3 * wo.z.abs().powi(8) } else { 0.1 })
+    fn pdf(&self, _wi: DVec3, _wo: DVec3) -> f64 {
+        0.0
+    }
+    fn flags(&self) -> BsdfFlags {
+        BsdfFlags::REFLECTION | BsdfFlags::TRANSMISSION | BsdfFlags::DIFFUSE | BsdfFlags::GLOSSY
+    }
+}
+impl ComponentModel for Two {
+    fn eval_component(&self, _wi: DVec3, wo: DVec3, c: Component) -> Rgb {
+        match c {
+            Component::Surface => Rgb::splat(0.05 + 0.3 * wo.z.abs().powi(8)),
+            Component::Multiple => Rgb::splat(0.1),
+            _ => Rgb::ZERO,
+        }
+    }
+    fn is_rgb(&self) -> bool {
+        false
+    }
+    fn components(&self) -> &'static [Component] {
+        &[Component::Surface, Component::Multiple]
     }
 }
 

@@ -3,7 +3,7 @@
 //! PyO3 bindings of the project's crates, with numpy arrays: the models by
 //! name (`paperbsdf-io`'s registry, so errors carry the CLI's messages),
 //! vectorised `eval`, `pdf`, `sample` and `albedo` in the conventions of
-//! DESIGN.md section 2 (`f` without cosine, `wi` toward the light, `wo` toward
+//! docs/design.md section 2 (`f` without cosine, `wi` toward the light, `wo` toward
 //! the viewer, local frame with `+z` the front face's normal), the fitter
 //! (`paperbsdf-fit`) and the ground-truth simulator (`paperbsdf-sim`).
 //!
@@ -486,10 +486,12 @@ fn fit(
         })
         .collect::<PyResult<Vec<_>>>()?;
     let model = model.to_string();
-    let result = py.detach(move || -> Result<String, String> {
-        let ds = paperbsdf_fit::dataset::load_dataset(&data, thickness)?;
+    // PyErr is created lazily (no GIL needed) and is Send: built here, raised after.
+    let fit_error = |e: paperbsdf_fit::FitError| value_error(e.to_string());
+    py.detach(move || -> PyResult<String> {
+        let ds = paperbsdf_fit::dataset::load_dataset(&data, thickness).map_err(fit_error)?;
         let cands = paperbsdf_fit::models::candidates(&model, ds.thickness, ds.channels == 3, Some(&dists))
-            .map_err(|e| e.to_string())?;
+            .map_err(fit_error)?;
         let opts = paperbsdf_fit::FitOptions {
             global_samples: samples,
             local_starts: starts,
@@ -502,11 +504,10 @@ fn fit(
             progress: false,
             ..Default::default()
         };
-        let out = paperbsdf_fit::fit(&ds.points, ds.channels, &cands, &opts).map_err(|e| e.to_string())?;
+        let out = paperbsdf_fit::fit(&ds.points, ds.channels, &cands, &opts).map_err(fit_error)?;
         let json = out.to_json(&ds.origins, fit_theta_i.as_deref());
-        serde_json::to_string(&json).map_err(|e| e.to_string())
-    });
-    result.map_err(value_error)
+        serde_json::to_string(&json).map_err(|e| value_error(e.to_string()))
+    })
 }
 
 /// `(text, origin, is_toml)` of a parameter source (a file path, or inline

@@ -35,7 +35,7 @@ impl Ray {
 }
 
 /// An orthonormal frame whose `z` axis is a given normal; converts world
-/// directions to the BSDF's local frame (DESIGN.md section 2: `+z` = front normal).
+/// directions to the BSDF's local frame (docs/design.md section 2: `+z` = front normal).
 #[derive(Clone, Copy, Debug)]
 pub struct Frame {
     /// First tangent.

@@ -196,7 +196,7 @@ fn mesh_that_fails_to_load() {
 #[test]
 fn invalid_parameter() {
     let dir = tempfile::tempdir().unwrap();
-    // A paper parameter outside its range (DESIGN.md section 3): named with its value.
+    // A paper parameter outside its range (docs/design.md section 3): named with its value.
     let m = load_err(
         dir.path(),
         &GOOD.replace("preset = \"matte\"", "preset = \"matte\"\nm_f = 2.5"),

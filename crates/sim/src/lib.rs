@@ -1,7 +1,7 @@
 //! # paperbsdf-sim: the ground truth
 //!
 //! A Monte Carlo simulation of the physical system the Paper BSDF approximates
-//! (DESIGN.md section 6): the sheet of [`paperbsdf_core::sheet::Sheet`], the
+//! (docs/design.md section 6): the sheet of [`paperbsdf_core::sheet::Sheet`], the
 //! one description that model and simulator share: a laterally infinite slab of
 //! a homogeneous scattering medium (`sigma_a`, `sigma_s`, two-lobe
 //! Henyey-Greenstein phase function) of index `eta_b` between two rough

@@ -1,9 +1,9 @@
 //! The physical system the simulator walks through: the sheet of
-//! [`paperbsdf_core::sheet::Sheet`] (its module doc defines it; DESIGN.md
+//! [`paperbsdf_core::sheet::Sheet`] (its module doc defines it; docs/design.md
 //! sections 2, 4.1 and 6): a laterally infinite slab of thickness `d` (front
 //! face `z = 0`, back face `z = -d`) of a homogeneous medium of index `eta_b`
 //! (`sigma_a`, `sigma_s`, the two-lobe Henyey-Greenstein phase function of
-//! DESIGN.md 4.2) between two rough dielectric faces, the front one over a thin
+//! docs/design.md 4.2) between two rough dielectric faces, the front one over a thin
 //! coating of index `eta_f` when `eta_f != eta_b`, with air (index 1) outside.
 //!
 //! Each face is a [`FaceOptics`] in its own local frame, whose `+z` is the

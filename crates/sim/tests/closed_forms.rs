@@ -10,7 +10,7 @@
 //! `f_r = Tf(mu_i) Tf(mu_o) a p(cos_s) (1 - exp(-tau (1/mu_i + 1/mu_o))) / (mu_i + mu_o)`
 //! with the film's transmittance `Tf = (1 - F)^2 / (1 - F^2) = (1 - F) / (1 + F)`
 //! (incoherent multiple reflections between two interfaces of the same Fresnel
-//! reflectance `F(mu)`, Born & Wolf 1.6), DESIGN.md 4.4 with `eta = 1` inside.
+//! reflectance `F(mu)`, Born & Wolf 1.6), docs/design.md 4.4 with `eta = 1` inside.
 //! This checks the coating's two interfaces, their bounces and the radiance
 //! factors of its refractions. With both faces index-matched,
 //! `f_t = a p (exp(-tau/mu_o) - exp(-tau/mu_i)) / (mu_o - mu_i)`.

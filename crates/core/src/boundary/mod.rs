@@ -1,5 +1,5 @@
 //! Integrals of a rough dielectric boundary that the Paper BSDF needs
-//! (DESIGN.md 4.1): the directional transmittance from outside `Att(mu)` (the
+//! (docs/design.md 4.1): the directional transmittance from outside `Att(mu)` (the
 //! paper's `rho_dt`), the directional reflectance from outside, the directional
 //! reflectance and transmittance from inside (total internal reflection
 //! included), and the hemispherical-hemispherical internal reflectance

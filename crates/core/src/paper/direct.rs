@@ -1,4 +1,4 @@
-//! The angular spread of light that crosses a sheet unscattered (DESIGN.md
+//! The angular spread of light that crosses a sheet unscattered (docs/design.md
 //! 4.6), shared by the Paper BSDF's direct transmission and the sheet
 //! transmission of the `lambert-glass` model.
 //!

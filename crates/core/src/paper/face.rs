@@ -1,8 +1,8 @@
-//! One face of the sheet as the Paper BSDF sees it (DESIGN.md 4.1, and the
+//! One face of the sheet as the Paper BSDF sees it (docs/design.md 4.1, and the
 //! physical sheet of [`crate::sheet`]): its reflection, its directional and
 //! hemispherical integrals (`Att`, outside reflectance, `rho_in`, `Tbar_in`),
 //! and the smooth refraction into the base through the macro normal that the
-//! single- and multiple-scattering terms use (DESIGN.md 4.4).
+//! single- and multiple-scattering terms use (docs/design.md 4.4).
 //!
 //! A face is built in three steps, each a closed form on the tabulated
 //! integrals of Walter's rough interface ([`crate::boundary`]):

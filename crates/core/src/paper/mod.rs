@@ -1,4 +1,4 @@
-//! The Paper BSDF of Papas, de Mesa and Jensen (EGSR 2014), DESIGN.md section 4.
+//! The Paper BSDF of Papas, de Mesa and Jensen (EGSR 2014), docs/design.md section 4.
 //!
 //! A slab of thickness `d` (front face `z = 0`, back face `z = -d`) of a
 //! scattering medium between two rough dielectric faces, each with its own
@@ -7,18 +7,18 @@
 //! by [`Bsdf::eval`]:
 //!
 //! - [`Component::Surface`]: the reflection of the face the light arrives at,
-//!   DESIGN.md 4.3: Walter's lobe, plus the separable lobes of the energy
+//!   docs/design.md 4.3: Walter's lobe, plus the separable lobes of the energy
 //!   compensation and of a coating ([`face`]); a delta lobe for a face without
 //!   microfacets.
 //! - [`Component::Single`]: single scattering (Hanrahan & Krueger 1993) in
 //!   reflection and transmission, with the `Att` losses of the faces and the
-//!   `1/eta_b^2` of the exit, DESIGN.md 4.4; see [`single`].
+//!   `1/eta_b^2` of the exit, docs/design.md 4.4; see [`single`].
 //! - [`Component::Multiple`]: light scattered more than once, whose split
 //!   between reflection and transmission comes from multipole diffusion
 //!   `R_d`, `T_d` (Donner & Jensen 2005; supplement eqs. 2 and 4; see
 //!   [`multipole`]) and whose amount closes the energy balance (below).
 //! - [`Component::Direct`]: light crossing the slab unscattered (our
-//!   extension, DESIGN.md 4.6; [`PaperOptions::direct`] switches it off); a
+//!   extension, docs/design.md 4.6; [`PaperOptions::direct`] switches it off); a
 //!   delta lobe when neither face deviates light, otherwise the kernel of
 //!   [`direct`]. With air on both sides it leaves parallel to the way it came in.
 //!
@@ -297,7 +297,7 @@ impl PaperBsdf {
         Self::with_options(p, PaperOptions::default())
     }
 
-    /// The reduced multilayer model of the supplement (Figure 5, DESIGN.md
+    /// The reduced multilayer model of the supplement (Figure 5, docs/design.md
     /// 4.7): the Paper BSDF with every `Att` set to 1 (multiple scattering is
     /// flat `R_d / pi`, `T_d / pi`), bounded as a whole (module doc).
     pub fn reduced_multilayer(p: &PaperParams) -> Result<PaperBsdf, ParamError> {

@@ -1,6 +1,6 @@
 //! Multiple scattering of the Paper BSDF: the total diffuse reflectance `R_d`
 //! and transmittance `T_d` of a slab in the multipole diffusion model of
-//! Donner & Jensen (2005), DESIGN.md 4.5.
+//! Donner & Jensen (2005), docs/design.md 4.5.
 //!
 //! The supplement (equations 2 and 4) gives, for `2n + 1` dipole pairs,
 //! `R_d = a'/2 sum_i [sign(z_r,i) e^{-sigma_tr |z_r,i|} - sign(z_v,i) e^{-sigma_tr |z_v,i|}]`
@@ -24,7 +24,7 @@
 //!
 //! **Source depth.** The dipole model puts the real source at `l = 1/sigma_t'`.
 //! When `1/sigma_t' > d` (a thin or weakly scattering sheet) the source lies
-//! outside the slab and the closed forms go negative (DESIGN.md 4.5). We use
+//! outside the slab and the closed forms go negative (docs/design.md 4.5). We use
 //! instead [`source_depth`]: the mean depth of the first reduced-scattering
 //! event *given that it happens inside the slab*,
 //! `l = (1/sigma_t') (1 - x / (e^x - 1))` with `x = sigma_t' d`. It equals

@@ -1,4 +1,4 @@
-//! Single scattering in a slab (Hanrahan & Krueger 1993, DESIGN.md 4.4).
+//! Single scattering in a slab (Hanrahan & Krueger 1993, docs/design.md 4.4).
 //!
 //! A collimated beam that has entered with flux `F` per unit area (per unit
 //! incident irradiance: `Att(wi)`) travels inside at cosine `mu_i`; at depth

@@ -20,7 +20,7 @@
 //!    `D` the tabulated NDF and `sigma` the projected area of the microsurface.
 //!
 //! The file's value is `f cos(theta_o)`; [`MeasuredBsdf::eval_raw`] divides the
-//! cosine out (the project's convention, DESIGN.md section 2). Anisotropic files
+//! cosine out (the project's convention, docs/design.md section 2). Anisotropic files
 //! with a reduced azimuth range (`phi_i` covering pi or pi/2) are folded by the
 //! material's symmetry as the format description prescribes.
 //!

@@ -4,7 +4,7 @@ A sheet of paper as a thin slab of scattering medium between two rough
 dielectric faces: surface reflection, single and multiple scattering and
 transmission (the Rust crates of the paperbsdf workspace, through PyO3).
 
-Conventions (the project's DESIGN.md, section 2): directions are unit vectors
+Conventions (docs/design.md, section 2): directions are unit vectors
 in the local frame whose +z is the front face's normal; ``wi`` points toward
 the light, ``wo`` toward the viewer; ``eval`` is f(wi, wo) *without* the cosine
 factor, RGB. Lengths in millimetres, coefficients in 1/mm.
@@ -45,7 +45,7 @@ __all__ = [
     "fit",
 ]
 
-#: Model names (DESIGN.md 4.7): ``paper`` and ``reduced-multilayer`` take the
+#: Model names (docs/design.md 4.7): ``paper`` and ``reduced-multilayer`` take the
 #: Paper BSDF's parameters, ``lambert-glass`` takes ``k_d, k_t, eta, m, dist``,
 #: ``rough-dielectric`` takes ``eta, m, dist``.
 MODEL_NAMES = ("paper", "reduced-multilayer", "lambert-glass", "rough-dielectric")
@@ -63,7 +63,7 @@ _PAPER_MODELS = ("paper", "reduced-multilayer")
 def _params_text(params: Any, model: str, argname: str = "params") -> tuple[str, str, bool]:
     """(text, origin, is_toml) of a parameter source for the native loader.
 
-    ``params`` is a dict of the DESIGN.md keys (written one key per line, so
+    ``params`` is a dict of the docs/design.md keys (written one key per line, so
     an error's line number points at the key), a JSON string starting with
     ``{``, a preset name (paper models), or a path to a JSON or TOML file.
     """
@@ -108,7 +108,7 @@ class Bsdf:
     """A scattering model by name: ``Bsdf(model, params)``.
 
     ``model`` is one of :data:`MODEL_NAMES`; ``params`` a dict with the keys
-    of DESIGN.md section 3, a JSON string, a file path (JSON or TOML), or for
+    of docs/design.md section 3, a JSON string, a file path (JSON or TOML), or for
     the paper models a preset name (``matte``, ``luster``, ``glossy``).
     """
 

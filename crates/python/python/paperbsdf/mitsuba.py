@@ -8,7 +8,7 @@ other models) in Mitsuba scenes, the way ``roughplastic`` is used.
 Properties (scene XML ``<string name=... value=.../>`` or ``load_dict`` keys):
 
 - ``params``: the parameters, inline JSON or a path to a JSON/TOML file
-  (DESIGN.md section 3), or
+  (docs/design.md section 3), or
 - ``preset``: ``matte``, ``luster`` or ``glossy``;
 - ``model``: ``paper`` (default), ``reduced-multilayer``, ``lambert-glass``
   or ``rough-dielectric``.
