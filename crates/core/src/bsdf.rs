@@ -109,6 +109,25 @@ pub trait Bsdf: Send + Sync {
     fn flags(&self) -> BsdfFlags;
 }
 
+/// The lobe of a mixture sampler that `uc` in [0, 1) selects, with the start
+/// of its interval: the first `k` whose interval `[sum(probs[..k]),
+/// sum(probs[..=k]))` of the cumulative probabilities holds `uc`, if its
+/// probability is positive (`(uc - start) / probs[k]` is then a fresh uniform
+/// number for the lobe). Where rounding leaves `uc` at or beyond the sum of
+/// `probs` (which should be 1), the last lobe with a positive probability;
+/// `None` when no lobe has one.
+pub fn select_lobe<const N: usize>(uc: f64, probs: &[f64; N]) -> Option<(usize, f64)> {
+    let mut acc = 0.0;
+    for (k, &p) in probs.iter().enumerate() {
+        if uc < acc + p {
+            return (p > 0.0).then_some((k, acc));
+        }
+        acc += p;
+    }
+    let k = probs.iter().rposition(|&p| p > 0.0)?;
+    Some((k, probs[..k].iter().sum()))
+}
+
 /// Share of the total albedo estimate that [`defensive_probabilities`] adds
 /// to each present lobe's estimate.
 pub const LOBE_PROB_FLOOR: f64 = 0.02;
@@ -194,4 +213,28 @@ pub fn albedo_from(bsdf: &dyn Bsdf, wi: DVec3, n: usize) -> (Rgb, Rgb) {
             bsdf.eval(wi, s.wi) * (s.wi.z.abs() / s.pdf)
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each `uc` selects the lobe whose cumulative interval holds it; a lobe of
+    /// probability zero is never selected; `uc` beyond a sum that rounding left
+    /// below 1 selects the last lobe that can be sampled instead of running off
+    /// the end (the Paper BSDF's sampler indexed a fifth lobe there before).
+    #[test]
+    fn select_lobe_follows_the_cumulative_probabilities() {
+        let p = [0.25, 0.0, 0.5, 0.25];
+        assert_eq!(select_lobe(0.0, &p), Some((0, 0.0)));
+        assert_eq!(select_lobe(0.2499, &p), Some((0, 0.0)));
+        assert_eq!(select_lobe(0.25, &p), Some((2, 0.25)));
+        assert_eq!(select_lobe(0.7499, &p), Some((2, 0.25)));
+        assert_eq!(select_lobe(0.75, &p), Some((3, 0.75)));
+        // A sum of 1 - 2^-53 and uc just below 1.
+        let q = [0.5, 0.5 - f64::EPSILON / 2.0, 0.0];
+        assert!(q.iter().sum::<f64>() < 1.0);
+        assert_eq!(select_lobe(1.0 - f64::EPSILON / 4.0, &q), Some((1, 0.5)));
+        assert_eq!(select_lobe(0.3, &[0.0; 3]), None);
+    }
 }

@@ -23,7 +23,7 @@
 //! nodes are the limit `eta -> 1+` of a rough face (an index-matched
 //! microsurface still masks, and its walk returns that light).
 
-use crate::boundary::tables::{eta_node, m_node};
+use crate::boundary::tables::{bilinear_corners, eta_node, m_node};
 use crate::microfacet::{Distribution, Microfacet};
 use crate::microsurface::Microsurface;
 use glam::DVec3;
@@ -229,14 +229,6 @@ pub fn node(dist: Distribution, i: usize, j: usize) -> HemisphericalEstimate {
     e
 }
 
-/// Lower node index and fraction of a coordinate `s` in [0, 1] on `n` nodes.
-#[inline]
-fn cell(s: f64, n: usize) -> (usize, f64) {
-    let x = s.clamp(0.0, 1.0) * (n - 1) as f64;
-    let i = (x as usize).min(n - 2);
-    (i, x - i as f64)
-}
-
 /// The orders >= 2 fractions of the face (dist, eta, m), bilinear in the
 /// coordinates of [`crate::boundary::tables`] (`sqrt((eta - 1) / 4)`,
 /// `sqrt(m / (pi / 2))`). `eta` in [1, 5], `m` in [0, pi/2] (validate with
@@ -246,15 +238,8 @@ fn cell(s: f64, n: usize) -> (usize, f64) {
 /// interface decides itself whether to use these (they are below 1e-6 for
 /// `m < 1e-4`).
 pub fn lost_energy(dist: Distribution, eta: f64, m: f64) -> LostEnergy {
-    let (i, fi) = cell(((eta - 1.0) / 4.0).max(0.0).sqrt(), N_ETA);
-    let (j, fj) = cell((m / std::f64::consts::FRAC_PI_2).max(0.0).sqrt(), N_M);
     let mut v = [0.0; 4];
-    for (ci, cj, w) in [
-        (i, j, (1.0 - fi) * (1.0 - fj)),
-        (i, j + 1, (1.0 - fi) * fj),
-        (i + 1, j, fi * (1.0 - fj)),
-        (i + 1, j + 1, fi * fj),
-    ] {
+    for (ci, cj, w) in bilinear_corners(eta, m, N_ETA, N_M) {
         if w == 0.0 {
             continue;
         }

@@ -33,7 +33,7 @@
 //! `R_s(mu) + Att(mu) (k_d + k_t + (1 - k_d - k_t) X) <= R_s(mu) + Att(mu) <= 1`
 //! with `X <= 1` the clear part's exit fraction.
 
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample};
+use crate::bsdf::{select_lobe, Bsdf, BsdfFlags, BsdfSample};
 use crate::dielectric::{RoughDielectric, RoughDielectricParams};
 use crate::fresnel::fresnel_dielectric;
 use crate::geometry::sample_cosine_hemisphere;
@@ -378,15 +378,7 @@ impl Bsdf for LambertGlass {
             return None;
         }
         let pr = self.lobe_probs(wo);
-        let mut k = 0;
-        let mut acc = 0.0;
-        while k < 3 && uc >= acc + pr[k] {
-            acc += pr[k];
-            k += 1;
-        }
-        if pr[k] <= 0.0 {
-            return None;
-        }
+        let (k, _) = select_lobe(uc, &pr)?;
         let so = wo.z.signum();
         let x = Side::of(wo);
         let wi = match k {

@@ -83,6 +83,23 @@ fn cell(s: f64, n: usize) -> (usize, f64) {
     (i, x - i as f64)
 }
 
+/// The four nodes `(i, j)` around the face `(eta, m)` on a grid of `n_eta` x
+/// `n_m` nodes in the coordinates `sqrt((eta - 1) / 4)` and `sqrt(m / (pi / 2))`
+/// (those of [`eta_node`], [`m_node`]), with their bilinear weights; values
+/// beyond the grid are read at its edge. Shared by these tables and the
+/// coarser ones of [`crate::microsurface_tables`].
+#[inline]
+pub(crate) fn bilinear_corners(eta: f64, m: f64, n_eta: usize, n_m: usize) -> [(usize, usize, f64); 4] {
+    let (i, fi) = cell(((eta - 1.0) / 4.0).max(0.0).sqrt(), n_eta);
+    let (j, fj) = cell((m / std::f64::consts::FRAC_PI_2).max(0.0).sqrt(), n_m);
+    [
+        (i, j, (1.0 - fi) * (1.0 - fj)),
+        (i, j + 1, (1.0 - fi) * fj),
+        (i + 1, j, fi * (1.0 - fj)),
+        (i + 1, j + 1, fi * fj),
+    ]
+}
+
 /// Interpolated integrals of a rough face (`m > 0`, `eta > 1`).
 pub fn interpolate(dist: Distribution, eta: f64, m: f64) -> SurfaceIntegrals {
     let t = table();
@@ -115,14 +132,7 @@ fn node_integrals(i: usize, j: usize, v: &[f64; NODE_LEN]) -> SurfaceIntegrals {
 /// curves and aligned with the critical cosine for the inside ones. Exposed so that the interpolation can
 /// be checked against nodes computed directly.
 pub fn interpolate_nodes(eta: f64, m: f64, node: impl Fn(usize, usize) -> [f64; NODE_LEN]) -> SurfaceIntegrals {
-    let (i, fi) = cell(((eta - 1.0) / 4.0).max(0.0).sqrt(), N_ETA);
-    let (j, fj) = cell((m / std::f64::consts::FRAC_PI_2).max(0.0).sqrt(), N_M);
-    let corners = [
-        (i, j, (1.0 - fi) * (1.0 - fj)),
-        (i, j + 1, (1.0 - fi) * fj),
-        (i + 1, j, fi * (1.0 - fj)),
-        (i + 1, j + 1, fi * fj),
-    ];
+    let corners = bilinear_corners(eta, m, N_ETA, N_M);
     let grid = MuGrid::new(eta, m);
     let mut s = SurfaceIntegrals::zeroed(grid);
     let mut out_mu = [0.0; N_MU];

@@ -5,7 +5,7 @@
 use super::eval::Lobe;
 use super::face::to_face_frame;
 use super::{grazing, side, ComponentSet, PaperBsdf, Side};
-use crate::bsdf::{Bsdf, BsdfFlags, BsdfSample};
+use crate::bsdf::{select_lobe, Bsdf, BsdfFlags, BsdfSample};
 use crate::geometry::sample_cosine_hemisphere;
 use crate::spectrum::Rgb;
 use glam::{DVec2, DVec3};
@@ -20,17 +20,8 @@ impl Bsdf for PaperBsdf {
             return None;
         }
         let pr = self.lobe_probs(wo);
-        // The lobe whose interval of the cumulative probabilities holds `uc`.
-        let mut k = 0;
-        let mut acc = 0.0;
-        while k < 4 && uc >= acc + pr.0[k] {
-            acc += pr.0[k];
-            k += 1;
-        }
+        let (k, acc) = select_lobe(uc, &pr.0)?;
         let lobe = Lobe::ALL[k];
-        if pr[lobe] <= 0.0 {
-            return None;
-        }
         let x = side(wo);
         let sx = x.sign();
         let wi = match lobe {
