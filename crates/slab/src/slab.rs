@@ -1,0 +1,236 @@
+//! The sheet as a stack: front face, medium, back face, per Fourier order.
+
+use crate::error::SlabError;
+use crate::interface::smooth_interface;
+use crate::layer::{default_start_thickness, medium_layer, Layer};
+use crate::phase::{phase_fourier, validate};
+use crate::quad::Grid;
+use paperbsdf_core::dielectric::ETA_RANGE;
+use paperbsdf_core::phase::TwoLobeHg;
+use paperbsdf_core::ParamError;
+use rayon::prelude::*;
+
+/// The scattering medium between the faces.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Medium {
+    /// Single-scattering albedo `sigma_s / sigma_t`, in `[0, 1]`.
+    pub albedo: f64,
+    /// Optical thickness `sigma_t d`, in `[0, inf)`.
+    pub tau: f64,
+    /// The two-lobe Henyey-Greenstein phase function (`|g| < 1` for both lobes).
+    pub phase: TwoLobeHg,
+}
+
+/// A face of the sheet.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Face {
+    /// A smooth Fresnel interface to air of relative index `eta` in `[1, 5]`
+    /// (1: no interface).
+    Smooth {
+        /// Relative index (medium over air).
+        eta: f64,
+    },
+}
+
+impl Face {
+    /// The face's relative index.
+    pub fn eta(&self) -> f64 {
+        match *self {
+            Face::Smooth { eta } => eta,
+        }
+    }
+}
+
+/// The sheet to solve: a medium between a front face (top, `+z`) and a back face.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlabSpec {
+    /// The medium.
+    pub medium: Medium,
+    /// The front face (light from `+z` meets it first).
+    pub front: Face,
+    /// The back face.
+    pub back: Face,
+}
+
+/// How finely the solver discretises.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Discretisation {
+    /// Gauss-Radau nodes per hemisphere outside (air), at least 2; the inside
+    /// grid has as many in the cone that refracts out ([`crate::quad`]).
+    pub nodes: usize,
+    /// Gauss-Legendre nodes in the cone of total internal reflection (used
+    /// when the medium's index exceeds 1), at least 1.
+    pub tir_nodes: usize,
+    /// Fourier orders `0..orders` in azimuth, at least 1 (totals need only order 0).
+    pub orders: usize,
+    /// Thickness of the starting layer before doubling; `None` for
+    /// [`default_start_thickness`].
+    pub start_thickness: Option<f64>,
+}
+
+impl Default for Discretisation {
+    fn default() -> Self {
+        Discretisation {
+            nodes: 32,
+            tir_nodes: 16,
+            orders: 1,
+            start_thickness: None,
+        }
+    }
+}
+
+/// Which face the light arrives at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// From above (`+z`), onto the front face.
+    Front,
+    /// From below, onto the back face.
+    Back,
+}
+
+/// The solved stack: per Fourier order, the sheet's matrices between the
+/// outside grids above and below (both [`Solution::outside`]).
+#[derive(Clone, Debug)]
+pub struct Solution {
+    /// The grid in air on either side of the sheet.
+    pub outside: Grid,
+    /// The grid inside the medium.
+    pub inside: Grid,
+    /// The sheet's layer per Fourier order.
+    pub orders: Vec<Layer>,
+    /// The medium layer alone for each order (inside grid).
+    pub medium: Vec<Layer>,
+    /// Doublings used for the medium.
+    pub doublings: u32,
+    /// The phase function's normalisation factors ([`crate::phase::PhaseFourier::scale`]).
+    pub phase_scale: Vec<f64>,
+}
+
+impl SlabSpec {
+    /// Checks every parameter (ranges named in the messages).
+    pub fn validate(&self) -> Result<(), SlabError> {
+        ParamError::check_range("albedo", self.medium.albedo, 0.0, 1.0)?;
+        ParamError::check_range("tau", self.medium.tau, 0.0, 1e12)?;
+        validate(&self.medium.phase)?;
+        ParamError::check_range("eta_f", self.front.eta(), ETA_RANGE.0, ETA_RANGE.1)?;
+        ParamError::check_range("eta_b", self.back.eta(), ETA_RANGE.0, ETA_RANGE.1)?;
+        if self.front.eta() != self.back.eta() {
+            return Err(SlabError::Unsupported(
+                "faces of different indices (eta_f != eta_b: the coated sheet of docs/design.md 4.1)",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Solves the sheet with discretisation `disc`: Fourier orders in parallel.
+    pub fn solve(&self, disc: &Discretisation) -> Result<Solution, SlabError> {
+        self.validate()?;
+        if disc.nodes < 2 {
+            return Err(SlabError::Discretisation {
+                name: "nodes",
+                value: disc.nodes as f64,
+                range: "[2, inf)",
+            });
+        }
+        if disc.tir_nodes < 1 {
+            return Err(SlabError::Discretisation {
+                name: "tir_nodes",
+                value: disc.tir_nodes as f64,
+                range: "[1, inf)",
+            });
+        }
+        let outside = Grid::outside(disc.nodes);
+        let inside = Grid::inside(&outside, self.front.eta(), disc.tir_nodes);
+        let phase = phase_fourier(&self.medium.phase, &inside, disc.orders)?;
+        let start = disc.start_thickness.unwrap_or_else(|| default_start_thickness(&inside));
+        let front = match self.front {
+            Face::Smooth { .. } => smooth_interface(&outside, &inside),
+        };
+        let back = match self.back {
+            Face::Smooth { .. } => smooth_interface(&outside, &inside).flipped(),
+        };
+        let solved: Vec<(Layer, Layer, u32)> = (0..disc.orders)
+            .into_par_iter()
+            .map(|m| {
+                let (med, k) = medium_layer(&inside, &phase, m, self.medium.albedo, self.medium.tau, start)?;
+                let med = med.into_layer();
+                let sheet = front.add(&med)?.add(&back)?;
+                Ok((sheet, med, k))
+            })
+            .collect::<Result<_, SlabError>>()?;
+        let doublings = solved.first().map_or(0, |s| s.2);
+        let (orders, medium): (Vec<Layer>, Vec<Layer>) = solved.into_iter().map(|(a, b, _)| (a, b)).unzip();
+        Ok(Solution {
+            outside,
+            inside,
+            orders,
+            medium,
+            doublings,
+            phase_scale: phase.scale,
+        })
+    }
+}
+
+impl Solution {
+    /// Order 0's reflection and transmission for light arriving at `side`.
+    fn rt0(&self, side: Side) -> (&nalgebra::DMatrix<f64>, &nalgebra::DMatrix<f64>) {
+        let l = &self.orders[0];
+        match side {
+            Side::Front => (&l.r_top, &l.t_down),
+            Side::Back => (&l.r_bot, &l.t_up),
+        }
+    }
+    /// Total reflectance and transmittance (everything that leaves, mirror
+    /// reflection and unscattered light included) for collimated light at
+    /// outside node `j` arriving at `side`: `sum_o w_o mu_o K[o][j] / (w_j mu_j)`.
+    pub fn totals_collimated(&self, side: Side, j: usize) -> (f64, f64) {
+        let g = &self.outside;
+        let (r, t) = self.rt0(side);
+        let flux = |k: &nalgebra::DMatrix<f64>| -> f64 {
+            (0..g.len()).map(|o| g.w[o] * g.mu[o] * k[(o, j)]).sum::<f64>() / (g.w[j] * g.mu[j])
+        };
+        (flux(r), flux(t))
+    }
+    /// Totals for collimated light at normal incidence (the Radau node `mu = 1`).
+    pub fn totals_normal(&self, side: Side) -> (f64, f64) {
+        self.totals_collimated(side, self.outside.len() - 1)
+    }
+    /// Totals for diffuse light (uniform radiance over the hemisphere) arriving at `side`.
+    pub fn totals_diffuse(&self, side: Side) -> (f64, f64) {
+        let g = &self.outside;
+        let (r, t) = self.rt0(side);
+        let flux = |k: &nalgebra::DMatrix<f64>| -> f64 {
+            let mut s = 0.0;
+            for o in 0..g.len() {
+                for j in 0..g.len() {
+                    s += g.w[o] * g.mu[o] * k[(o, j)];
+                }
+            }
+            2.0 * s
+        };
+        (flux(r), flux(t))
+    }
+    /// The sheet's BSDF `f` (without cosine, radiance transport) between
+    /// outside nodes: light arriving at `side` from node `j`, leaving by
+    /// reflection (`transmit = false`) or transmission from node `o`, at
+    /// azimuth difference `phi` (radians, between the propagation directions:
+    /// `phi = 0` is forward scattering in the plane of incidence), summed over
+    /// the solved orders: `f = sum_m (2 - [m = 0]) / (2 pi) K_m[o][j] cos(m phi) / (w_j mu_j)`.
+    /// Delta parts (mirror reflection, unscattered light) sit on the diagonal
+    /// `o = j` as finite values of the discretisation, not as BSDF values.
+    pub fn bsdf_at_nodes(&self, side: Side, transmit: bool, o: usize, j: usize, phi: f64) -> f64 {
+        let g = &self.outside;
+        let mut f = 0.0;
+        for (m, l) in self.orders.iter().enumerate() {
+            let k = match (side, transmit) {
+                (Side::Front, false) => &l.r_top,
+                (Side::Front, true) => &l.t_down,
+                (Side::Back, false) => &l.r_bot,
+                (Side::Back, true) => &l.t_up,
+            };
+            let eps = if m == 0 { 1.0 } else { 2.0 };
+            f += eps * k[(o, j)] * (m as f64 * phi).cos();
+        }
+        f / (2.0 * std::f64::consts::PI * g.w[j] * g.mu[j])
+    }
+}
