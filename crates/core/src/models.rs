@@ -39,7 +39,7 @@ use crate::fresnel::fresnel_dielectric;
 use crate::geometry::sample_cosine_hemisphere;
 use crate::microfacet::Distribution;
 use crate::paper::direct::SheetKernel;
-use crate::paper::face::{to_face_frame, Face};
+use crate::paper::face::Face;
 use crate::paper::grazing;
 pub use crate::paper::{Component, ComponentSet, PaperBsdf, Side};
 use crate::params::{Colour, ParamError};
@@ -316,7 +316,7 @@ impl LambertGlass {
         if reflect {
             if set.contains(Component::Surface) {
                 let e = Side::of(wi);
-                out += Rgb::splat(self.face.reflection(to_face_frame(wi, e), to_face_frame(wo, e)));
+                out += Rgb::splat(self.face.reflection(e.local(wi), e.local(wo)));
             }
             if set.contains(Component::Multiple) {
                 out += self.k_d * self.body(wi, wo);
@@ -357,7 +357,7 @@ impl LambertGlass {
         }
         if wi.z * wo.z > 0.0 {
             let e = Side::of(wo);
-            pr[0] * self.face.reflection_pdf(to_face_frame(wi, e), to_face_frame(wo, e)) + pr[1] * wi.z.abs() / PI
+            pr[0] * self.face.reflection_pdf(e.local(wi), e.local(wo)) + pr[1] * wi.z.abs() / PI
         } else {
             let mut p = pr[2] * wi.z.abs() / PI;
             if !self.kernel.is_delta() {
@@ -393,7 +393,7 @@ impl Bsdf for LambertGlass {
                         flags: BsdfFlags::REFLECTION | BsdfFlags::SPECULAR,
                     });
                 }
-                to_face_frame(self.face.sample_reflection(to_face_frame(wo, x), u)?, x)
+                x.local(self.face.sample_reflection(x.local(wo), u)?)
             }
             1 | 2 => {
                 let w = sample_cosine_hemisphere(u);

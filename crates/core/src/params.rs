@@ -136,25 +136,33 @@ impl<'de> serde::Deserialize<'de> for Colour {
             fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Colour, E> {
                 Ok(Colour::Scalar(v as f64))
             }
-            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Colour, A::Error> {
-                let mut c = [0.0; 3];
-                let mut n = 0usize;
-                while let Some(v) = seq.next_element::<f64>()? {
-                    if n < 3 {
-                        c[n] = v;
-                    }
-                    n += 1;
-                }
-                if n != 3 {
-                    return Err(serde::de::Error::custom(format!(
-                        "an array of {n} numbers; expected {EXPECTED}"
-                    )));
-                }
-                Ok(Colour::Rgb(c))
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Colour, A::Error> {
+                read_rgb_triple(seq, EXPECTED).map(Colour::Rgb)
             }
         }
         d.deserialize_any(V)
     }
+}
+
+/// Reads an RGB triple from a serde sequence: exactly three numbers, else the
+/// error `an array of N numbers; expected {expected}` (`expected` lists the
+/// forms the caller accepts). Shared by [`Colour`]'s reader and the colours of
+/// `paperbsdf-render`'s scene files (which also accept textures).
+pub fn read_rgb_triple<'de, A: serde::de::SeqAccess<'de>>(mut seq: A, expected: &str) -> Result<[f64; 3], A::Error> {
+    let mut c = [0.0; 3];
+    let mut n = 0usize;
+    while let Some(v) = seq.next_element::<f64>()? {
+        if n < 3 {
+            c[n] = v;
+        }
+        n += 1;
+    }
+    if n != 3 {
+        return Err(serde::de::Error::custom(format!(
+            "an array of {n} numbers; expected {expected}"
+        )));
+    }
+    Ok(c)
 }
 
 impl Colour {

@@ -16,7 +16,7 @@
 //! direction (the multipole `R(r)` is a flux density too).
 
 use crate::estimate::SimError;
-use crate::slab::{Face, Slab};
+use crate::slab::{Side, Slab};
 use crate::walk::{Tally, Tracer};
 use indicatif::{ProgressBar, ProgressStyle};
 use paperbsdf_core::{DVec3, Rgb};
@@ -130,7 +130,7 @@ pub fn simulate_exit_profile(slab: &Slab, wi: DVec3, cfg: &LateralConfig) -> Res
     };
     let (h, nbins) = (cfg.half_width, cfg.bins);
     let inv_w = nbins as f64 / (2.0 * h);
-    let lit = Face::lit_by(wi);
+    let lit = Side::of(wi);
     let jobs: Vec<(usize, u64)> = channels.iter().flat_map(|&c| (0..nb).map(move |b| (c, b))).collect();
     let results: Vec<(usize, Vec<f64>, f64)> = jobs
         .par_iter()
@@ -143,7 +143,7 @@ pub fn simulate_exit_profile(slab: &Slab, wi: DVec3, cfg: &LateralConfig) -> Res
             for i in 0..per_batch {
                 tally.clear();
                 tracer.walk_with_exits_at(wi, &mut rng, &mut tally, &mut |dir, flux, xy| {
-                    if Face::toward(dir) == lit {
+                    if Side::of(dir) == lit {
                         let k = ((xy.x + h) * inv_w).floor().clamp(0.0, (nbins - 1) as f64) as usize;
                         hist[k] += flux;
                         r += flux;

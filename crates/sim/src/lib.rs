@@ -33,4 +33,4 @@ pub mod walk;
 
 pub use estimate::{simulate_bsdf, simulate_totals, BsdfRun, Estimate, Incidence, SimConfig, SimError, Totals};
 pub use lateral::{simulate_exit_profile, ExitProfile, LateralConfig};
-pub use slab::{Face, Medium, Slab};
+pub use slab::{Medium, Side, Slab};

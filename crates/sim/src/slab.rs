@@ -8,66 +8,14 @@
 //!
 //! Each face is a [`FaceOptics`] in its own local frame, whose `+z` is the
 //! side of the air: for the front face that is the slab frame itself, for the
-//! back face the slab frame with `z` flipped ([`Face::local`]). The BSDFs are
+//! back face the slab frame with `z` flipped ([`Side::local`]). The BSDFs are
 //! isotropic, so the mirror image is as good a frame as a rotation.
 
 use crate::faces::FaceOptics;
+pub use paperbsdf_core::paper::Side;
 use paperbsdf_core::phase::TwoLobeHg;
 use paperbsdf_core::sheet::Sheet;
-use paperbsdf_core::{DVec3, PaperParams, ParamError};
-
-/// One of the slab's two faces.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Face {
-    /// The front face, `z = 0`, air above (`z > 0`).
-    Front,
-    /// The back face, `z = -d`, air below (`z < 0`).
-    Back,
-}
-
-impl Face {
-    /// The other face.
-    #[inline]
-    pub fn other(self) -> Face {
-        match self {
-            Face::Front => Face::Back,
-            Face::Back => Face::Front,
-        }
-    }
-    /// Depth of the face for a slab of thickness `d`: `0` or `-d`.
-    #[inline]
-    pub fn z(self, d: f64) -> f64 {
-        match self {
-            Face::Front => 0.0,
-            Face::Back => -d,
-        }
-    }
-    /// A slab-frame vector in the face's local frame (`+z` toward the air on
-    /// that side) and back: the map is its own inverse.
-    #[inline]
-    pub fn local(self, v: DVec3) -> DVec3 {
-        match self {
-            Face::Front => v,
-            Face::Back => DVec3::new(v.x, v.y, -v.z),
-        }
-    }
-    /// The face a propagation direction inside the slab heads for (`z > 0`:
-    /// front), which is also the face through which a viewer direction `wo`
-    /// sees the slab (`wo.z > 0`: front).
-    #[inline]
-    pub fn toward(dir: DVec3) -> Face {
-        if dir.z > 0.0 {
-            Face::Front
-        } else {
-            Face::Back
-        }
-    }
-    /// The face at which light from direction `wi` (pointing toward the light) arrives.
-    #[inline]
-    pub fn lit_by(wi: DVec3) -> Face {
-        Face::toward(wi)
-    }
-}
+use paperbsdf_core::{PaperParams, ParamError};
 
 /// The medium of one colour channel: extinction and single-scattering albedo.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -118,10 +66,10 @@ impl Slab {
 
     /// How the walk treats a face.
     #[inline]
-    pub fn face(&self, f: Face) -> &FaceOptics {
+    pub fn face(&self, f: Side) -> &FaceOptics {
         match f {
-            Face::Front => &self.front,
-            Face::Back => &self.back,
+            Side::Front => &self.front,
+            Side::Back => &self.back,
         }
     }
 

@@ -92,7 +92,7 @@ mod tally;
 
 pub use tally::Tally;
 
-use crate::slab::{Face, Medium, Slab};
+use crate::slab::{Medium, Side, Slab};
 use nee::{draw_exits, Target, Vertex};
 use paperbsdf_core::phase::{sample_hg_cos, HgLobes};
 use paperbsdf_core::DVec3;
@@ -226,7 +226,7 @@ impl<'a> Tracer<'a> {
         let mut xy = glam::DVec2::ZERO;
         let d = self.slab.d;
         tally.order = 0;
-        let lit = Face::lit_by(wi);
+        let lit = Side::of(wi);
         let wi_l = lit.local(wi);
         self.lit_face_reflection(lit, wi_l, rng, tally);
         let Some((mut dir, mut weight)) =
@@ -246,7 +246,7 @@ impl<'a> Tracer<'a> {
             if dir.z == 0.0 {
                 return; // parallel to the faces: measure zero
             }
-            let x = Face::toward(dir);
+            let x = Side::of(dir);
             let dist = (x.z(d) - z) / dir.z;
             let t = if self.med.sigma_t > 0.0 {
                 -(1.0 - rng.gen::<f64>()).ln() / self.med.sigma_t
@@ -341,11 +341,11 @@ mod tests {
     #[test]
     fn face_frames() {
         let v = DVec3::new(0.3, -0.2, 0.9);
-        assert_eq!(Face::Front.local(v), v);
-        assert_eq!(Face::Back.local(Face::Back.local(v)), v);
-        assert!(Face::Back.local(v).z < 0.0);
-        assert_eq!(Face::toward(DVec3::new(0.0, 0.0, -1.0)), Face::Back);
-        assert_eq!(Face::Back.z(0.2), -0.2);
+        assert_eq!(Side::Front.local(v), v);
+        assert_eq!(Side::Back.local(Side::Back.local(v)), v);
+        assert!(Side::Back.local(v).z < 0.0);
+        assert_eq!(Side::of(DVec3::new(0.0, 0.0, -1.0)), Side::Back);
+        assert_eq!(Side::Back.z(0.2), -0.2);
     }
 
     #[test]

@@ -3,7 +3,6 @@
 //! of [`super::build`], with the geometry (inside cosines, phase function)
 //! that `eval` and `pdf` share.
 
-use super::face::to_face_frame;
 use super::tables::{lerp_nodes, NP};
 use super::{grazing, side, single, Component, ComponentSet, PaperBsdf, TAU_DROP};
 use crate::spectrum::Rgb;
@@ -136,7 +135,7 @@ impl PaperBsdf {
         if reflect && set.contains(Component::Surface) {
             let f = match surface {
                 Some(f) => f,
-                None => self.faces[e].reflection_with_sqrt(to_face_frame(wi, e), to_face_frame(wo, e), si, so),
+                None => self.faces[e].reflection_with_sqrt(e.local(wi), e.local(wo), si, so),
             };
             out += Rgb::splat(f);
         }
@@ -286,7 +285,7 @@ impl PaperBsdf {
                 pdf += pr[Lobe::Surface]
                     * match surface_pdf {
                         Some(p) => p,
-                        None => self.faces[x].reflection_pdf(to_face_frame(wi, x), to_face_frame(wo, x)),
+                        None => self.faces[x].reflection_pdf(x.local(wi), x.local(wo)),
                     };
             }
             pdf += pr[Lobe::MultipleR] * wi.z.abs() / PI;

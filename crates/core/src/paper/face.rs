@@ -33,10 +33,9 @@
 //!    `R + T = 1` for energy-conserving interfaces.
 //!
 //! The back face (`z = -d`) is the same kind of object seen with `z` flipped:
-//! [`to_face_frame`] maps a direction on the back side to the face's frame.
+//! [`Side::local`](super::Side::local) maps a direction on the back side to the face's frame.
 
 use super::tables::{hemispherical, hemispherical_of_table, lerp_mu, lerp_nodes, node_at, NA};
-use super::Side;
 use crate::boundary::{critical_mu, SurfaceIntegrals};
 use crate::dielectric::{Interface, RoughDielectric};
 use crate::fresnel::fresnel_dielectric;
@@ -45,15 +44,6 @@ use crate::params::{FaceScattering, ParamError};
 use crate::sheet::Sheet;
 use glam::DVec3;
 use std::f64::consts::PI;
-
-/// Mirrors `w` into the frame of the face on `side` (front: identity; back: `z -> -z`).
-#[inline]
-pub(crate) fn to_face_frame(w: DVec3, side: Side) -> DVec3 {
-    match side {
-        Side::Front => w,
-        Side::Back => DVec3::new(w.x, w.y, -w.z),
-    }
-}
 
 /// For `wi`, `wo` both above a face: `(h.z^2, (wo.h)^2)` of their unit half
 /// vector `h = (wi + wo) / |wi + wo|`, without forming it: `|wi + wo|^2 =

@@ -154,6 +154,26 @@ impl Side {
             Side::Back
         }
     }
+    /// A sheet-frame vector in the frame of the face on this side (`+z` toward
+    /// the air on that side) and back: the identity for the front, `z -> -z`
+    /// for the back (the map is its own inverse; the faces are isotropic, so
+    /// the mirror image is as good a frame as a rotation).
+    #[inline]
+    pub fn local(self, v: DVec3) -> DVec3 {
+        match self {
+            Side::Front => v,
+            Side::Back => DVec3::new(v.x, v.y, -v.z),
+        }
+    }
+    /// The depth `z` of the face on this side in a sheet of thickness `d` (mm):
+    /// `0` for the front, `-d` for the back.
+    #[inline]
+    pub fn z(self, d: f64) -> f64 {
+        match self {
+            Side::Front => 0.0,
+            Side::Back => -d,
+        }
+    }
     /// The opposite side.
     #[inline]
     pub fn other(self) -> Side {

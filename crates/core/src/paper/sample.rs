@@ -3,7 +3,6 @@
 //! samples it (module doc of [`super`]).
 
 use super::eval::Lobe;
-use super::face::to_face_frame;
 use super::{grazing, side, ComponentSet, PaperBsdf, Side};
 use crate::bsdf::{select_lobe, Bsdf, BsdfFlags, BsdfSample};
 use crate::geometry::sample_cosine_hemisphere;
@@ -37,7 +36,7 @@ impl Bsdf for PaperBsdf {
                         flags: BsdfFlags::REFLECTION | BsdfFlags::SPECULAR,
                     });
                 }
-                to_face_frame(fx.sample_reflection(to_face_frame(wo, x), u)?, x)
+                x.local(fx.sample_reflection(x.local(wo), u)?)
             }
             Lobe::Single => {
                 let fx = &self.faces[x];
@@ -87,7 +86,7 @@ impl Bsdf for PaperBsdf {
         let geo = self.inside(wi, wo, true, (wi.z.abs().min(1.0).sqrt(), wo.z.abs().min(1.0).sqrt()));
         // Reflection on a rough face: its value and density share the half vector.
         let (surf_f, surf_pdf) = if wi.z * wo.z > 0.0 && self.faces[x].microfacet().is_some() {
-            let (f, p) = self.faces[x].reflection_and_pdf(to_face_frame(wi, x), to_face_frame(wo, x), geo.si, geo.so);
+            let (f, p) = self.faces[x].reflection_and_pdf(x.local(wi), x.local(wo), geo.si, geo.so);
             (Some(f), Some(p))
         } else {
             (None, None)

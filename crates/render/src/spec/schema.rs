@@ -86,20 +86,8 @@ impl<'de> Deserialize<'de> for ColourSpec {
             fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<ColourSpec, E> {
                 Ok(ColourSpec::Scalar(v as f64))
             }
-            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<ColourSpec, A::Error> {
-                let (mut c, mut n) = ([0.0; 3], 0usize);
-                while let Some(v) = seq.next_element::<f64>()? {
-                    if n < 3 {
-                        c[n] = v;
-                    }
-                    n += 1;
-                }
-                if n != 3 {
-                    return Err(serde::de::Error::custom(format!(
-                        "an array of {n} numbers; expected {EXPECTED}"
-                    )));
-                }
-                Ok(ColourSpec::Rgb(c))
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<ColourSpec, A::Error> {
+                paperbsdf_core::params::read_rgb_triple(seq, EXPECTED).map(ColourSpec::Rgb)
             }
             fn visit_map<M: serde::de::MapAccess<'de>>(self, map: M) -> Result<ColourSpec, M::Error> {
                 TextureSpec::deserialize(serde::de::value::MapAccessDeserializer::new(map)).map(ColourSpec::Texture)

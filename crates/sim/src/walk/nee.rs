@@ -9,7 +9,7 @@
 
 use super::{Tally, Tracer};
 use crate::faces::{FaceOptics, StochFace};
-use crate::slab::{Face, Slab};
+use crate::slab::{Side, Slab};
 use paperbsdf_core::{DVec3, RoughDielectric, TransportMode};
 use rand::Rng;
 use std::f64::consts::PI;
@@ -55,7 +55,7 @@ pub(super) struct ExitDraw {
 #[derive(Clone, Debug)]
 pub(super) struct Target {
     /// The face through which the slab is seen from `wo`.
-    pub(super) face: Face,
+    pub(super) face: Side,
     /// `wo` in that face's local frame (`z > 0`).
     pub(super) wo_l: DVec3,
     exit: Exit,
@@ -76,7 +76,7 @@ pub(super) enum Vertex {
     Volume { z: f64, prev: DVec3 },
     /// A surface event at `face` for light arriving from `w_from_l` (face-local,
     /// pointing away from the surface toward where the light came from).
-    Surface { face: Face, w_from_l: DVec3 },
+    Surface { face: Side, w_from_l: DVec3 },
 }
 
 impl Target {
@@ -84,7 +84,7 @@ impl Target {
     /// the face it sees and how light leaves through it (before calibration,
     /// see [`Tracer::calibrate_targets`]).
     pub(super) fn new(slab: &Slab, wo: DVec3) -> Self {
-        let face = Face::toward(wo);
+        let face = Side::of(wo);
         let wo_l = face.local(wo);
         let exit = match *slab.face(face) {
             FaceOptics::Walter(b) => Exit::Rough(b),
@@ -280,7 +280,7 @@ impl Tracer<'_> {
         if w.z == 0.0 || weight == 0.0 {
             return;
         }
-        let x = Face::toward(w);
+        let x = Side::of(w);
         let dz = (self.depth(v) - x.z(self.slab.d)).abs();
         let mut tr = f64::NAN;
         for (j, t) in self.targets.iter().enumerate() {

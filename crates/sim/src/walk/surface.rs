@@ -11,7 +11,7 @@
 use super::nee::Vertex;
 use super::{Tally, Tracer};
 use crate::faces::FaceOptics;
-use crate::slab::Face;
+use crate::slab::Side;
 use paperbsdf_core::{DVec3, TransportMode};
 use rand::Rng;
 
@@ -20,7 +20,7 @@ impl Tracer<'_> {
     /// face `lit`) toward each viewer on its side: `f = eval_mode(wi, wo,
     /// Radiance)` of the face (an unbiased estimate for a stochastic face;
     /// nothing for a delta face, whose mirror reflection is a Dirac delta in `wo`).
-    pub(super) fn lit_face_reflection<R: Rng>(&self, lit: Face, wi_l: DVec3, rng: &mut R, tally: &mut Tally) {
+    pub(super) fn lit_face_reflection<R: Rng>(&self, lit: Side, wi_l: DVec3, rng: &mut R, tally: &mut Tally) {
         for (j, t) in self.targets.iter().enumerate() {
             if t.face == lit {
                 let f = match self.slab.face(lit) {
@@ -43,10 +43,10 @@ impl Tracer<'_> {
     #[allow(clippy::too_many_arguments)]
     pub(super) fn surface_vertex<R: Rng, E: FnMut(DVec3, f64)>(
         &self,
-        face: Face,
+        face: Side,
         w_from_l: DVec3,
         weight: f64,
-        lit: Face,
+        lit: Side,
         rng: &mut R,
         tally: &mut Tally,
         on_exit: &mut E,
