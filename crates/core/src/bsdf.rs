@@ -164,10 +164,12 @@ pub fn sampled_albedo(bsdf: &dyn Bsdf, wo: DVec3, n: usize) -> (Rgb, Rgb) {
 }
 
 /// The `n x n` stratified sampling loop of [`sampled_albedo`] and
-/// [`albedo_from`]: draws from [`Bsdf::sample`] started at `w` (lobe choice from
-/// a fixed low-discrepancy offset), weighs each sample with `weight`, and sums
-/// the weights on `w`'s side (reflection) and the other (transmission).
-fn stratified_albedo(bsdf: &dyn Bsdf, w: DVec3, n: usize, weight: impl Fn(&BsdfSample) -> Rgb) -> (Rgb, Rgb) {
+/// [`albedo_from`] (and of instruments that leave part of the hemisphere out):
+/// draws from [`Bsdf::sample`] started at `w` (lobe choice from a fixed
+/// low-discrepancy offset), weighs each sample with `weight` (non-finite
+/// weights are skipped), and returns the mean weights on `w`'s side
+/// (reflection) and the other (transmission).
+pub fn stratified_albedo(bsdf: &dyn Bsdf, w: DVec3, n: usize, weight: impl Fn(&BsdfSample) -> Rgb) -> (Rgb, Rgb) {
     let (mut r, mut t) = (Rgb::ZERO, Rgb::ZERO);
     let inv = 1.0 / n as f64;
     let golden = 0.618_033_988_749_894_9;

@@ -87,35 +87,10 @@ impl Quality {
 /// [`paperbsdf_core::bsdf::sampled_albedo`]), leaving out reflected `wi` within
 /// the cone `wi . axis > trap_cos` when `trap` is `Some((axis, trap_cos))`.
 pub fn albedo_with_trap(bsdf: &dyn Bsdf, wo: DVec3, n: usize, trap: Option<(DVec3, f64)>) -> (Rgb, Rgb) {
-    let (mut r, mut t) = (Rgb::ZERO, Rgb::ZERO);
-    let inv = 1.0 / n as f64;
-    let golden = 0.618_033_988_749_894_9;
-    for i in 0..n {
-        for j in 0..n {
-            let k = (i * n + j) as f64;
-            let uc = (0.5 + k * golden).fract();
-            let u = [
-                (i as f64 + 0.5) * inv,
-                ((j as f64 + (0.5 + k * 0.754_877_666).fract()) * inv).min(1.0 - 1e-12),
-            ];
-            let Some(s) = bsdf.sample(wo, uc, u) else { continue };
-            let w = s.weight();
-            if !w.is_finite() {
-                continue;
-            }
-            if s.wi.z * wo.z > 0.0 {
-                if let Some((axis, c)) = trap {
-                    if s.wi.dot(axis) > c {
-                        continue;
-                    }
-                }
-                r += w;
-            } else {
-                t += w;
-            }
-        }
-    }
-    (r * (inv * inv), t * (inv * inv))
+    paperbsdf_core::bsdf::stratified_albedo(bsdf, wo, n, |s| match trap {
+        Some((axis, c)) if s.wi.z * wo.z > 0.0 && s.wi.dot(axis) > c => Rgb::ZERO,
+        _ => s.weight(),
+    })
 }
 
 /// The factors of one sheet that the measurements are built from (per channel).
