@@ -23,7 +23,7 @@
 //! nodes are the limit `eta -> 1+` of a rough face (an index-matched
 //! microsurface still masks, and its walk returns that light).
 
-use crate::boundary::tables::{bilinear_corners, eta_node, m_node};
+use crate::boundary::tables::{bilinear_corners, decode_f32_table, eta_node, m_node};
 use crate::microfacet::{Distribution, Microfacet};
 use crate::microsurface::Microsurface;
 use glam::DVec3;
@@ -204,17 +204,7 @@ static TABLE_BYTES: &[u8] = include_bytes!("../data/microsurface_tables.bin");
 
 fn table() -> &'static [f32] {
     static TABLE: OnceLock<Vec<f32>> = OnceLock::new();
-    TABLE.get_or_init(|| {
-        assert_eq!(
-            TABLE_BYTES.len(),
-            4 * TABLE_LEN,
-            "microsurface_tables.bin has the wrong size; regenerate it"
-        );
-        TABLE_BYTES
-            .chunks_exact(4)
-            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect()
-    })
+    TABLE.get_or_init(|| decode_f32_table(TABLE_BYTES, TABLE_LEN, "microsurface_tables.bin"))
 }
 
 /// The stored values and standard errors of node (dist, i, j), as generated.

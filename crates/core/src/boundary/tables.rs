@@ -62,17 +62,19 @@ static TABLE_BYTES: &[u8] = include_bytes!("../../data/boundary_tables.bin");
 
 fn table() -> &'static [f32] {
     static TABLE: OnceLock<Vec<f32>> = OnceLock::new();
-    TABLE.get_or_init(|| {
-        assert_eq!(
-            TABLE_BYTES.len(),
-            4 * TABLE_LEN,
-            "boundary_tables.bin has the wrong size; regenerate it"
-        );
-        TABLE_BYTES
-            .chunks_exact(4)
-            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect()
-    })
+    TABLE.get_or_init(|| decode_f32_table(TABLE_BYTES, TABLE_LEN, "boundary_tables.bin"))
+}
+
+/// The little-endian `f32` values of a table file compiled into the library
+/// (`include_bytes!`), which must hold exactly `len` of them. A wrong size is a
+/// build of the library with a stale file, not bad input: it panics, naming
+/// the file to regenerate.
+pub(crate) fn decode_f32_table(bytes: &[u8], len: usize, file: &str) -> Vec<f32> {
+    assert_eq!(bytes.len(), 4 * len, "{file} has the wrong size; regenerate it");
+    bytes
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
 }
 
 /// Fractional grid coordinate and lower index for a value `x` mapped to [0, 1] by `s`.
