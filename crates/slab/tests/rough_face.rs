@@ -6,7 +6,8 @@
 //!
 //! Reference: `paperbsdf_core::boundary::directional_albedo_n` (Walter's
 //! `R` and `T` by a 128 x 128 Gauss-Legendre rule in the square of visible
-//! normals, exact to about 1e-6 for these faces), from outside at each
+//! normals; it converges slowly itself, within 4e-4 of its 256-point rule for
+//! m <= 0.5 and 1.2e-3 at m = 1, measured), from outside at each
 //! outside node and from inside at each inside node.
 //!
 //! The projection's error is that of the grids' quadrature in `mu` of a lobe
@@ -18,8 +19,15 @@
 //! core's (GGX m = 0.15 at normal incidence, the narrowest lobe; 7e-3 for
 //! m = 0.3, 1.2e-2 for 0.5); normalised to core's `R + T` (the solver's
 //! default) the split is within 1.0e-3 from outside and 5.1e-3 from inside
-//! (GGX m = 0.5; 2.1e-3 at m = 0.15). Asked: raw 4e-2, normalised 2e-3
-//! from outside and 6e-3 from inside.
+//! (GGX m = 0.5; 2.1e-3 at m = 0.15; GGX m = 0.3: 9.7e-4, 3.3e-3; Beckmann
+//! m = 0.15: 1.4e-4, 3.2e-3, m = 0.3: 1.1e-4, 1.8e-3). Asked: raw 4e-2,
+//! normalised 2e-3 from outside and 6e-3 from inside.
+//!
+//! With `"multiple"` faces every node's `R + T` is 1 within 1e-12 (the
+//! normalisation's tolerance; measured 9e-13), far inside issue 14's 2e-3,
+//! and `k_o` is core's (`PaperBsdf::face_compensation`) exactly; `k_i`,
+//! which follows from the `Lbar` of the grid instead of core's tables, is
+//! within 0.4% of core's.
 
 use nalgebra::DMatrix;
 use paperbsdf_core::boundary::{dir_at_mu, directional_albedo_n};
@@ -51,8 +59,9 @@ fn references(bd: &RoughDielectric, out: &Grid, ins: &Grid) -> References {
     (at(out, 1.0), at(ins, -1.0))
 }
 
-/// Points per axis of core's rule for the references (the 256-point rule agrees to about 1e-6).
-const REFERENCE_POINTS: usize = 64;
+/// Points per axis of core's rule for the references (as the normalisation's targets,
+/// [`paperbsdf_slab::interface::ALBEDO_POINTS`]; within 4e-4 of the 256-point rule for m <= 0.5).
+const REFERENCE_POINTS: usize = 128;
 
 /// Largest `|R - R_core|`, `|T - T_core|` over the nodes from outside and from inside.
 fn albedo_errors(refs: &References, l: &Layer, out: &Grid, ins: &Grid) -> (f64, f64) {
@@ -71,11 +80,10 @@ fn albedo_errors(refs: &References, l: &Layer, out: &Grid, ins: &Grid) -> (f64, 
 #[test]
 fn single_face_albedo_matches_cores_quadrature() {
     let (out, ins) = grids(1.5, 32);
+    // GGX m = 0.3 and Beckmann m = 0.15 measured as well (module doc), left out for time
     for (dist, m) in [
         (Distribution::Ggx, 0.15),
-        (Distribution::Ggx, 0.3),
         (Distribution::Ggx, 0.5),
-        (Distribution::Beckmann, 0.15),
         (Distribution::Beckmann, 0.3),
     ] {
         let bd = RoughDielectric::new(dist, 1.5, m).unwrap();
@@ -132,8 +140,8 @@ fn multiple_face_conserves_energy_and_keeps_cores_shares() {
                 "{dist:?} m = {m}: |R + T - 1| <= {worst:.1e}, clipped {:.1e}; Lbar_o {:.4}, Lbar_i {:.4}; k_o {:.4} (core {k_o:.4}), k_i {:.4} (core {k_i:.4})",
                 c.clipped, c.lbar_out, c.lbar_in, c.k_out, c.k_in
             );
-            assert!(worst < 2e-3, "{worst}");
-            assert!((c.k_out - k_o).abs() < 1e-12 && (c.k_in - k_i).abs() < 0.02 * k_i.max(0.01));
+            assert!(worst < 1e-11, "{worst}");
+            assert!((c.k_out - k_o).abs() < 1e-12 && (c.k_in - k_i).abs() < 0.01 * k_i.max(0.01));
         }
     }
 }
