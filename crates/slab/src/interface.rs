@@ -245,7 +245,8 @@ pub const MAX_NORMALISATION_ITERATIONS: usize = 20_000;
 pub struct Projection {
     /// Fourier orders `0..orders`, at least 1.
     pub orders: usize,
-    /// Points of the azimuth rule on the circle ([`check_azimuth_points`]).
+    /// Gauss-Legendre points per panel of the azimuth rule (module doc;
+    /// [`check_azimuth_points`]).
     pub azimuth_points: usize,
     /// Whether Walter's matrices are scaled symmetrically to core's
     /// directional albedo at every node (module doc); `false` leaves the raw

@@ -110,8 +110,8 @@ pub struct Discretisation {
     /// Thickness of the starting layer before doubling; `None` for
     /// [`default_start_thickness`].
     pub start_thickness: Option<f64>,
-    /// Points on the circle of the azimuth quadrature that projects rough
-    /// faces ([`crate::interface`]): even, at least 8, above `2 orders`.
+    /// Gauss-Legendre points per panel of the azimuth rule that projects
+    /// rough faces ([`crate::interface`]), 2 to 64; default 8.
     pub azimuth_points: usize,
     /// Whether rough faces are normalised to core's directional albedo
     /// ([`crate::interface`]); default `true`.
