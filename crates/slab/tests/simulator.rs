@@ -8,7 +8,8 @@
 //! albedo 0.9975) and a paper-like one (d = 0.1 mm, sigma_s = 300,
 //! sigma_a = 0.1 /mm: tau = 30.01, albedo 0.99967). Light on the front at the
 //! outside nodes of 0 and 75.3 degrees (the simulator gets the node's exact
-//! direction); default discretisation (32 nodes).
+//! direction), and once on the back (thin sheet, `"multiple"`, 0 degrees);
+//! default discretisation (32 nodes).
 //!
 //! **Tolerance**: `3 sigma + 3e-3` per total, sigma the simulator's standard
 //! error. The 3e-3 holds the solver's discretisation (32 -> 64 nodes moves
@@ -57,10 +58,14 @@ fn totals_agree_with_the_simulator() {
             let sol = SlabSpec::from_params(&p, 0).unwrap().solve(&disc).unwrap();
             let slab = Slab::from_params(&p).unwrap();
             let g = &sol.outside;
-            for j in [g.len() - 1, 10] {
+            // the back face lit too, once (the sheet's faces differ)
+            let back = fs == FaceScattering::Multiple && name == "thin";
+            let cases = [(Side::Front, g.len() - 1), (Side::Front, 10), (Side::Back, g.len() - 1)];
+            for (side, j) in cases.into_iter().take(if back { 3 } else { 2 }) {
                 let mu = g.mu[j];
-                let wi = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
-                let (r, t) = sol.totals_collimated(Side::Front, j);
+                let z = if side == Side::Front { mu } else { -mu };
+                let wi = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, z);
+                let (r, t) = sol.totals_collimated(side, j);
                 let cfg = SimConfig {
                     samples: walks,
                     batches: 16,
@@ -71,7 +76,7 @@ fn totals_agree_with_the_simulator() {
                 let (sr, se_r) = (s.reflectance.mean.0[0], s.reflectance.stderr.0[0]);
                 let (st, se_t) = (s.transmittance.mean.0[0], s.transmittance.stderr.0[0]);
                 println!(
-                    "{fs:?} {name} theta {:.1}: slab R {r:.4} T {t:.4}; simulator R {sr:.4} +- {se_r:.4} T {st:.4} +- {se_t:.4}",
+                    "{fs:?} {name} {side:?} theta {:.1}: slab R {r:.4} T {t:.4}; simulator R {sr:.4} +- {se_r:.4} T {st:.4} +- {se_t:.4}",
                     mu.acos().to_degrees()
                 );
                 for (what, a, b, se) in [("R", r, sr, se_r), ("T", t, st, se_t)] {
