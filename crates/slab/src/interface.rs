@@ -18,11 +18,98 @@
 //!
 //! With the reciprocity weights `w mu / eta^2` these matrices satisfy the
 //! reciprocity relations of [`crate::layer`] exactly.
+//!
+//! **Rough interface** (`face_scattering = "single"`): the BSDF is core's
+//! Walter et al. (EGSR 2007) rough dielectric,
+//! [`RoughDielectric::eval_mode`] in [`TransportMode::Radiance`], whose
+//! refraction carries the same `n^2` radiance factor (Walter's eq. 21 with
+//! `eta_o^2`), so its transmission into the medium integrates to the flux
+//! transmittance and generalised reciprocity reads
+//! `f(wi, wo) / n_o^2 = f(wo, wi) / n_i^2`. Each block is projected as
+//! [`crate::layer`] defines a matrix entry,
+//! `K_m[o][j] = w_j mu_j integral_0^(2 pi) f(mu_j -> mu_o, phi) cos(m phi) dphi`,
+//! with `phi` the azimuth difference of the propagation directions (light
+//! propagating along `(sin_j, 0, -+mu_j)`, i.e. `wi = (-sin_j, 0, +-mu_j)`
+//! toward the light, leaving along `wo = (sin_o cos phi, sin_o sin phi, +-mu_o)`).
+//! `f` is even in `phi` (the mirror `y -> -y` of both directions), so only the
+//! cosine series exists and the integral is folded onto `[0, pi]`.
+//! **Azimuth rule.** Every lobe of a rough face peaks at `phi = 0` (the
+//! mirror and the refracted direction keep the azimuth), and between two
+//! grazing directions its width in `phi` shrinks with them, to about
+//! `m (mu_i + mu_o)` (e.g. 4e-4 for m = 0.15 at the smallest Radau node, where
+//! a uniform rule of 256 points overestimated the grazing reflectance by
+//! 2e-2). The rule is therefore composite Gauss-Legendre with `q`
+//! ([`crate::Discretisation::azimuth_points`], default
+//! [`DEFAULT_AZIMUTH_POINTS`] = 8) points per panel on `[0, pi]`:
+//! `P = max(16, orders)` uniform panels ([`MIN_AZIMUTH_PANELS`]), the first
+//! of which is split geometrically toward 0 into panels
+//! `[0, d], [d, 2d], [2d, 4d], ...` with `d = (pi / P) 2^-14`
+//! ([`AZIMUTH_GRADING_LEVELS`]): `q (P + 14)` points, 240 by default.
+//! Gauss-Legendre integrates the smooth parts to high order, and the panel
+//! edges bound the error of the kink where the refraction lobe ends; doubling
+//! `q` changes the totals of the sheets in the tests by less than 1e-6
+//! (tests/rough_convergence.rs).
+//!
+//! **Quadrature in `mu` and normalisation.** The nodes in `mu` are the
+//! grids' own, and a lobe is sampled at them: the refraction lobe ends with a
+//! kink (where a microfacet turns its back to one of the directions) that
+//! falls anywhere between nodes, and a lobe narrower than the node spacing
+//! (roughness m = 0.15 at normal incidence) is under-resolved. With 32
+//! outside nodes the raw order-0 albedos are off by up to 3e-2 (GGX m = 0.15)
+//! against core's quadrature of the same face
+//! (`paperbsdf_core::boundary::directional_albedo_n`, [`ALBEDO_POINTS`]
+//! points per axis). As the phase function's ([`crate::phase`]), the
+//! matrices are therefore rescaled symmetrically, `K[o][j] s_o s_j` in every
+//! order and block (outside and inside nodes have their own factors; a
+//! symmetric Sinkhorn iteration), so that every node's `R + T` is core's
+//! exactly: the symmetric scaling keeps reciprocity, and the factors
+//! ([`ProjectedFace::scale`]) show how far the raw projection was. The split
+//! between `R` and `T` keeps an error (measured in tests/rough_face.rs: up to
+//! 1e-3 from outside and 5e-3 from inside at 32 nodes). For Beckmann, core's
+//! albedo uses the exact Smith `G1` of the incident direction where
+//! `eval_mode` uses Walter's rational approximation (below 0.35% apart,
+//! `paperbsdf_core::microsurface`); the normalisation follows the former.
 
+//! **Energy compensation** (`face_scattering = "multiple"`): step 2 of
+//! `paperbsdf_core::paper::face`, the model's energy-conserving face. Walter's
+//! face loses `L_o(mu) = 1 - R(mu) - T(mu)` of the light from outside and
+//! `L_i(mu)` of the light from inside; the compensated face adds the
+//! separable, reciprocal lobes
+//! - reflection outside `(1 - k_o) L_o(mu_i) L_o(mu_o) / (pi Lbar_o)`,
+//! - transmission in `k_o L_o(mu_out) L_i(mu_in) / (pi Lbar_i)`,
+//! - reflection inside `(1 - k_i) L_i L_i / (pi Lbar_i)`,
+//! - transmission out `k_i L_i(mu_in) L_o(mu_out) / (pi Lbar_o)`,
+//!
+//! (`Lbar = 2 int L mu dmu`), whose albedos are `(1 - k) L` and `k L`, so each
+//! direction's `R + T` is 1 from both sides. The reflection lobe outside is
+//! core's (`paper::face`'s `SeparableLobe`); core gives only the albedos of
+//! the other three, and these are the separable reciprocal lobes with those
+//! albedos. `k_o` is core's: the transmitted share of the energy that the
+//! exact microsurface walk (Heitz et al. 2016) carries by orders >= 2
+//! (`paperbsdf_core::microsurface_tables::lost_energy`); `k_i` follows from
+//! reciprocity, `k_o Lbar_o = eta^2 k_i Lbar_i`, capped at 1 as core does.
+//! The solver takes `L_o`, `L_i` and the `Lbar` from Walter's face **as
+//! projected on the grids** (after normalisation, `1 - ` core's directional
+//! `R + T` at the node; core's model takes them from its tables of the same
+//! integrals), so that the discrete face conserves energy to rounding
+//! wherever Walter's projected albedo does not exceed 1 ([`Compensation::clipped`]).
+//! The compensation is independent of azimuth: it is order 0 only. The
+//! simulator's `"multiple"` faces are the exact walk instead, whose
+//! multiply scattered light is not separable; the tests measure the
+//! difference in the sheet's totals.
+
+use crate::error::SlabError;
 use crate::layer::Layer;
 use crate::quad::Grid;
 use nalgebra::DMatrix;
+use paperbsdf_core::boundary::{dir_at_mu, directional_albedo_n};
+use paperbsdf_core::dielectric::Interface;
 use paperbsdf_core::fresnel::fresnel_dielectric;
+use paperbsdf_core::microsurface_tables::lost_energy;
+use paperbsdf_core::quadrature::gauss_legendre_01;
+use paperbsdf_core::{DVec3, FaceScattering, RoughDielectric, TransportMode};
+use rayon::prelude::*;
+use std::f64::consts::PI;
 
 /// The smooth interface from the `outside` grid (air) to the `inside` grid
 /// made from it by [`Grid::inside`] (module doc). Index-matched (`eta = 1`):
@@ -51,5 +138,389 @@ pub fn smooth_interface(outside: &Grid, inside: &Grid) -> Layer {
         t_down,
         r_bot,
         t_up,
+    }
+}
+
+/// Default Gauss-Legendre points per panel of the azimuth rule
+/// ([`crate::Discretisation::azimuth_points`]; module doc).
+pub const DEFAULT_AZIMUTH_POINTS: usize = 8;
+
+/// Levels of geometric refinement of the azimuth rule's first panel toward
+/// `phi = 0` (module doc): its smallest panel is `2^-14` of a uniform one.
+pub const AZIMUTH_GRADING_LEVELS: i32 = 14;
+
+/// Smallest number of uniform panels of the azimuth rule on `[0, pi]`.
+pub const MIN_AZIMUTH_PANELS: usize = 16;
+
+/// The energy compensation of a `face_scattering = "multiple"` face as
+/// projected on the grids (module doc): the transmitted shares of the lost
+/// energy and the lost energy itself at every node.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Compensation {
+    /// `k_o`: transmitted share of the energy lost for light from outside
+    /// (from core's walk tables, `paperbsdf_core::microsurface_tables::lost_energy`).
+    pub k_out: f64,
+    /// `k_i`: transmitted share for light from inside, from reciprocity
+    /// `k_o Lbar_o = eta^2 k_i Lbar_i`.
+    pub k_in: f64,
+    /// `L_o` at the outside nodes: `1 - R - T` of Walter's projected face.
+    pub lost_out: Vec<f64>,
+    /// `L_i` at the inside nodes.
+    pub lost_in: Vec<f64>,
+    /// `Lbar_o = 2 sum_j w_j mu_j L_o(mu_j)` on the outside grid.
+    pub lbar_out: f64,
+    /// `Lbar_i`, the same on the inside grid.
+    pub lbar_in: f64,
+    /// The most negative `1 - R - T` that was clipped to 0 (0 if none): where
+    /// the projected Walter face reflects and transmits more than it receives.
+    pub clipped: f64,
+}
+
+/// A face projected on the grids: its layer per Fourier order and, for an
+/// energy-conserving rough face, its compensation.
+#[derive(Clone, Debug)]
+pub struct ProjectedFace {
+    /// The face's layer for orders `0..orders` (air on top, the medium below).
+    pub orders: Vec<Layer>,
+    /// The compensation of a `"multiple"` rough face, `None` otherwise.
+    pub compensation: Option<Compensation>,
+    /// The normalisation's factors `s` (outside nodes, then inside nodes;
+    /// module doc), all 1 without normalisation: how far the raw projection
+    /// was from core's albedo.
+    pub scale: Vec<f64>,
+}
+
+/// Checks the azimuth rule's points per panel: 2 to 64.
+pub fn check_azimuth_points(azimuth_points: usize) -> Result<(), SlabError> {
+    if !(2..=64).contains(&azimuth_points) {
+        return Err(SlabError::Discretisation {
+            name: "azimuth_points",
+            value: azimuth_points as f64,
+            range: "[2, 64] Gauss-Legendre points per panel",
+        });
+    }
+    Ok(())
+}
+
+/// The azimuth rule on `[0, pi]` for `orders` Fourier orders with `q`
+/// points per panel (module doc): `(phi_k, weight_k)`, the weights already
+/// doubled for the fold of the circle onto `[0, pi]`.
+pub fn azimuth_rule(orders: usize, q: usize) -> Vec<(f64, f64)> {
+    let panels = MIN_AZIMUTH_PANELS.max(orders);
+    let width = PI / panels as f64;
+    let mut edges = vec![0.0];
+    for k in (0..=AZIMUTH_GRADING_LEVELS).rev() {
+        edges.push(width * 2f64.powi(-k));
+    }
+    for p in 2..=panels {
+        edges.push(width * p as f64);
+    }
+    let (x, w) = gauss_legendre_01(q);
+    let mut rule = Vec::with_capacity(q * (edges.len() - 1));
+    for e in edges.windows(2) {
+        let len = e[1] - e[0];
+        for (xi, wi) in x.iter().zip(&w) {
+            rule.push((e[0] + len * xi, 2.0 * len * wi));
+        }
+    }
+    rule
+}
+
+/// Points per axis of core's visible-normal quadrature
+/// (`paperbsdf_core::boundary::directional_albedo_n`) that gives the albedo
+/// targets of the normalisation (module doc). Core's rule converges slowly
+/// (kinks of the masking and of total internal reflection on the microfacets):
+/// 128 points are within 4e-4 of its default 256 for m <= 0.5 (1.2e-3 at
+/// m = 1), at a quarter of the cost.
+pub const ALBEDO_POINTS: usize = 128;
+
+/// Iterations of the symmetric Sinkhorn scaling after which the
+/// normalisation gives up ([`SlabError::Discretisation`] naming `nodes`): it
+/// gains about a factor 60 per 100 iterations on a face whose raw albedo is
+/// off by 100% (m = 0.1 on 20 nodes), and converges in tens on resolved faces.
+pub const MAX_NORMALISATION_ITERATIONS: usize = 20_000;
+
+/// How a rough face is projected.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Projection {
+    /// Fourier orders `0..orders`, at least 1.
+    pub orders: usize,
+    /// Gauss-Legendre points per panel of the azimuth rule (module doc;
+    /// [`check_azimuth_points`]).
+    pub azimuth_points: usize,
+    /// Whether Walter's matrices are scaled symmetrically to core's
+    /// directional albedo at every node (module doc); `false` leaves the raw
+    /// point-sampled projection (for measuring its error).
+    pub normalise: bool,
+}
+
+/// The face `bd` (air above, medium of index `bd.eta` below) on the grids
+/// `outside` and `inside` (made by [`Grid::inside`] with `bd.eta`):
+/// index-matched faces are the identity, smooth ones [`smooth_interface`] in
+/// every order, rough ones the projection of `RoughDielectric::eval_mode`
+/// (radiance transport) as `proj` says, plus the compensation when
+/// `scattering` is [`FaceScattering::Multiple`] (module doc).
+pub fn face_interface(
+    bd: &RoughDielectric,
+    scattering: FaceScattering,
+    outside: &Grid,
+    inside: &Grid,
+    proj: &Projection,
+) -> Result<ProjectedFace, SlabError> {
+    let Projection {
+        orders,
+        azimuth_points,
+        normalise,
+    } = *proj;
+    if orders == 0 {
+        return Err(SlabError::Discretisation {
+            name: "orders",
+            value: 0.0,
+            range: "[1, inf)",
+        });
+    }
+    if outside.eta != 1.0 || inside.eta != bd.eta {
+        return Err(SlabError::Unsupported(
+            "a face projected on grids whose indices are not 1 outside and the face's index inside",
+        ));
+    }
+    let single = |l: Layer| ProjectedFace {
+        orders: vec![l; orders],
+        compensation: None,
+        scale: vec![1.0; outside.len() + inside.len()],
+    };
+    match bd.interface {
+        Interface::IndexMatched => Ok(single(Layer::identity(outside.len()))),
+        Interface::Smooth => Ok(single(smooth_interface(outside, inside))),
+        Interface::Rough(_) => {
+            check_azimuth_points(azimuth_points)?;
+            let mut orders_l = walter_projection(bd, outside, inside, orders, azimuth_points);
+            let scale = if normalise {
+                normalise_face(bd, outside, inside, &mut orders_l)?
+            } else {
+                vec![1.0; outside.len() + inside.len()]
+            };
+            let compensation = match scattering {
+                FaceScattering::Single => None,
+                FaceScattering::Multiple => Some(compensate(bd, outside, inside, &mut orders_l[0])),
+            };
+            Ok(ProjectedFace {
+                orders: orders_l,
+                compensation,
+                scale,
+            })
+        }
+    }
+}
+
+/// The four blocks of Walter's face for every order (module doc's rule).
+fn walter_projection(bd: &RoughDielectric, outside: &Grid, inside: &Grid, orders: usize, n_phi: usize) -> Vec<Layer> {
+    let rule = azimuth_rule(orders, n_phi);
+    let phis: Vec<(f64, f64, f64)> = rule.iter().map(|&(phi, wt)| (phi.cos(), phi.sin(), wt)).collect();
+    let cosm: Vec<Vec<f64>> = (0..orders)
+        .map(|m| rule.iter().map(|&(phi, _)| (m as f64 * phi).cos()).collect())
+        .collect();
+    let block = |from: &Grid, from_top: bool, to: &Grid, to_up: bool| -> Vec<DMatrix<f64>> {
+        let (nf, nt) = (from.len(), to.len());
+        let rows: Vec<Vec<f64>> = (0..nt)
+            .into_par_iter()
+            .map(|o| {
+                let mu_o = to.mu[o];
+                let s_o = (1.0 - mu_o * mu_o).max(0.0).sqrt();
+                let z_o = if to_up { mu_o } else { -mu_o };
+                let mut row = vec![0.0; orders * nf];
+                let mut vals = vec![0.0; phis.len()];
+                for j in 0..nf {
+                    let mu_j = from.mu[j];
+                    let s_j = (1.0 - mu_j * mu_j).max(0.0).sqrt();
+                    // toward the light: minus the propagation direction (s_j, 0, -+mu_j)
+                    let wi = DVec3::new(-s_j, 0.0, if from_top { mu_j } else { -mu_j });
+                    for (k, &(c, s, wt)) in phis.iter().enumerate() {
+                        let wo = DVec3::new(s_o * c, s_o * s, z_o);
+                        vals[k] = wt * bd.eval_mode(wi, wo, TransportMode::Radiance);
+                    }
+                    let scale = from.w[j] * mu_j;
+                    for (m, cm) in cosm.iter().enumerate() {
+                        let acc: f64 = vals.iter().zip(cm).map(|(v, c)| v * c).sum();
+                        row[m * nf + j] = scale * acc;
+                    }
+                }
+                row
+            })
+            .collect();
+        (0..orders)
+            .map(|m| DMatrix::from_fn(nt, nf, |o, j| rows[o][m * nf + j]))
+            .collect()
+    };
+    let r_top = block(outside, true, outside, true);
+    let t_down = block(outside, true, inside, false);
+    let r_bot = block(inside, false, inside, false);
+    let t_up = block(inside, false, outside, true);
+    r_top
+        .into_iter()
+        .zip(t_down)
+        .zip(r_bot.into_iter().zip(t_up))
+        .map(|((r_top, t_down), (r_bot, t_up))| Layer {
+            r_top,
+            t_down,
+            r_bot,
+            t_up,
+        })
+        .collect()
+}
+
+/// Scales every order of Walter's projected face `l` by `s_o s_j` so that the
+/// order-0 albedo `R + T` of every node matches core's quadrature of the face
+/// (module doc); returns the factors (outside nodes, then inside nodes).
+fn normalise_face(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut [Layer]) -> Result<Vec<f64>, SlabError> {
+    let target = |g: &Grid, side: f64| -> Vec<f64> {
+        g.mu.par_iter()
+            .map(|&mu| {
+                let (r, t) = directional_albedo_n(bd, dir_at_mu(mu, side), ALBEDO_POINTS);
+                r + t
+            })
+            .collect()
+    };
+    let (t_out, t_in) = (target(outside, 1.0), target(inside, -1.0));
+    let (no, ni) = (outside.len(), inside.len());
+    let (mut s_out, mut s_in) = (vec![1.0; no], vec![1.0; ni]);
+    let l0 = &l[0];
+    let mut converged = false;
+    for _ in 0..MAX_NORMALISATION_ITERATIONS {
+        let col = |k: &DMatrix<f64>, to: &Grid, s_to: &[f64], j: usize| -> f64 {
+            (0..to.len())
+                .map(|o| to.w[o] * to.mu[o] * s_to[o] * k[(o, j)])
+                .sum::<f64>()
+        };
+        let a_out: Vec<f64> = (0..no)
+            .map(|j| {
+                s_out[j] * (col(&l0.r_top, outside, &s_out, j) + col(&l0.t_down, inside, &s_in, j))
+                    / (outside.w[j] * outside.mu[j])
+            })
+            .collect();
+        let a_in: Vec<f64> = (0..ni)
+            .map(|j| {
+                s_in[j] * (col(&l0.r_bot, inside, &s_in, j) + col(&l0.t_up, outside, &s_out, j))
+                    / (inside.w[j] * inside.mu[j])
+            })
+            .collect();
+        let mut worst: f64 = 0.0;
+        for (s, (a, t)) in s_out.iter_mut().zip(a_out.iter().zip(&t_out)) {
+            if !(*a > 0.0 && a.is_finite()) {
+                return Err(unresolved());
+            }
+            worst = worst.max((a / t - 1.0).abs());
+            *s *= (t / a).sqrt();
+        }
+        for (s, (a, t)) in s_in.iter_mut().zip(a_in.iter().zip(&t_in)) {
+            if !(*a > 0.0 && a.is_finite()) {
+                return Err(unresolved());
+            }
+            worst = worst.max((a / t - 1.0).abs());
+            *s *= (t / a).sqrt();
+        }
+        if worst < 1e-12 {
+            converged = true;
+            break;
+        }
+    }
+    if !converged {
+        return Err(unresolved());
+    }
+    for layer in l.iter_mut() {
+        scale_rows_cols(&mut layer.r_top, &s_out, &s_out);
+        scale_rows_cols(&mut layer.t_down, &s_in, &s_out);
+        scale_rows_cols(&mut layer.r_bot, &s_in, &s_in);
+        scale_rows_cols(&mut layer.t_up, &s_out, &s_in);
+    }
+    Ok(s_out.into_iter().chain(s_in).collect())
+}
+
+/// `K[o][j] *= rows[o] cols[j]`.
+fn scale_rows_cols(k: &mut DMatrix<f64>, rows: &[f64], cols: &[f64]) {
+    for j in 0..k.ncols() {
+        for o in 0..k.nrows() {
+            k[(o, j)] *= rows[o] * cols[j];
+        }
+    }
+}
+
+/// The error of a face whose lobes the grid does not resolve at all.
+fn unresolved() -> SlabError {
+    SlabError::Discretisation {
+        name: "nodes",
+        value: f64::NAN,
+        range: "enough nodes to resolve the rough face's lobes (the normalisation to core's albedo did not converge)",
+    }
+}
+
+/// Flux albedo `sum_o w_o mu_o K[o][j] / (w_j mu_j)` of column `j` of `k` on output grid `to`.
+fn column_albedo(k: &DMatrix<f64>, to: &Grid, from: &Grid, j: usize) -> f64 {
+    (0..to.len()).map(|o| to.w[o] * to.mu[o] * k[(o, j)]).sum::<f64>() / (from.w[j] * from.mu[j])
+}
+
+/// Adds the separable compensation lobes of step 2 of `paperbsdf_core::paper::face`
+/// to order 0 of Walter's projected face `l` (module doc) and returns them.
+fn compensate(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut Layer) -> Compensation {
+    let mut clipped: f64 = 0.0;
+    let mut lost = |a: f64| {
+        let v = 1.0 - a;
+        clipped = clipped.min(v);
+        v.max(0.0)
+    };
+    let lost_out: Vec<f64> = (0..outside.len())
+        .map(|j| lost(column_albedo(&l.r_top, outside, outside, j) + column_albedo(&l.t_down, inside, outside, j)))
+        .collect();
+    let lost_in: Vec<f64> = (0..inside.len())
+        .map(|j| lost(column_albedo(&l.r_bot, inside, inside, j) + column_albedo(&l.t_up, outside, inside, j)))
+        .collect();
+    let lbar = |g: &Grid, lv: &[f64]| 2.0 * (0..g.len()).map(|j| g.w[j] * g.mu[j] * lv[j]).sum::<f64>();
+    let (lbar_o, lbar_i) = (lbar(outside, &lost_out), lbar(inside, &lost_in));
+    // The shares as core defines them (paperbsdf_core::paper::face, step 2).
+    let lost_tab = lost_energy(bd.dist, bd.eta, bd.m);
+    let tot = lost_tab.t_out2 + lost_tab.r_out2;
+    let mut k_o = if tot > 0.0 {
+        (lost_tab.t_out2 / tot).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let e2 = bd.eta * bd.eta;
+    let k_i = if lbar_i > 1e-12 && lbar_o > 0.0 {
+        let k_i = k_o * lbar_o / (e2 * lbar_i);
+        if k_i > 1.0 {
+            k_o = e2 * lbar_i / lbar_o;
+            1.0
+        } else {
+            k_i
+        }
+    } else {
+        k_o = 0.0;
+        0.0
+    };
+    // order 0 of f = c E_a(mu_j) E_b(mu_o): K[o][j] = w_j mu_j 2 pi c E_a(mu_j) E_b(mu_o)
+    let add = |k: &mut DMatrix<f64>, from: &Grid, ea: &[f64], to_e: &[f64], c: f64| {
+        if c == 0.0 {
+            return;
+        }
+        for j in 0..from.len() {
+            let a = 2.0 * PI * c * from.w[j] * from.mu[j] * ea[j];
+            for (o, eb) in to_e.iter().enumerate() {
+                k[(o, j)] += a * eb;
+            }
+        }
+    };
+    let inv = |x: f64| if x > 0.0 { 1.0 / (PI * x) } else { 0.0 };
+    add(&mut l.r_top, outside, &lost_out, &lost_out, (1.0 - k_o) * inv(lbar_o));
+    add(&mut l.t_down, outside, &lost_out, &lost_in, k_o * inv(lbar_i));
+    add(&mut l.r_bot, inside, &lost_in, &lost_in, (1.0 - k_i) * inv(lbar_i));
+    add(&mut l.t_up, inside, &lost_in, &lost_out, k_i * inv(lbar_o));
+    Compensation {
+        k_out: k_o,
+        k_in: k_i,
+        lost_out,
+        lost_in,
+        lbar_out: lbar_o,
+        lbar_in: lbar_i,
+        clipped,
     }
 }

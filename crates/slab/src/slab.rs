@@ -1,13 +1,15 @@
-//! The sheet as a stack: front face, medium, back face, per Fourier order.
+//! The sheet as a stack: front face, medium, back face, per Fourier order
+//! (the physical sheet of `paperbsdf_core::sheet` with air on both sides and
+//! faces of one index).
 
 use crate::error::SlabError;
-use crate::interface::smooth_interface;
+use crate::interface::{face_interface, Compensation, ProjectedFace, Projection, DEFAULT_AZIMUTH_POINTS};
 use crate::layer::{default_start_thickness, medium_layer, Layer};
 use crate::phase::{phase_fourier, validate};
 use crate::quad::Grid;
-use paperbsdf_core::dielectric::ETA_RANGE;
+use paperbsdf_core::dielectric::{ETA_RANGE, M_RANGE};
 use paperbsdf_core::phase::TwoLobeHg;
-use paperbsdf_core::ParamError;
+use paperbsdf_core::{Distribution, FaceScattering, PaperParams, ParamError, RoughDielectric, Sheet};
 use rayon::prelude::*;
 
 /// The scattering medium between the faces.
@@ -30,13 +32,55 @@ pub enum Face {
         /// Relative index (medium over air).
         eta: f64,
     },
+    /// A rough interface (core's [`RoughDielectric`]): relative index `eta`
+    /// in `[1, 5]`, roughness `m` in `[0, pi/2]` (below
+    /// `paperbsdf_core::dielectric::M_SMOOTH` it is smooth), distribution
+    /// `dist`, scattering once among its microfacets (Walter et al. 2007) or
+    /// with core's energy compensation (`scattering`; [`crate::interface`]).
+    Rough {
+        /// Relative index (medium over air).
+        eta: f64,
+        /// Microfacet roughness (alpha).
+        m: f64,
+        /// Microfacet distribution.
+        dist: Distribution,
+        /// `face_scattering` of docs/design.md 3.
+        scattering: FaceScattering,
+    },
 }
 
 impl Face {
     /// The face's relative index.
     pub fn eta(&self) -> f64 {
         match *self {
-            Face::Smooth { eta } => eta,
+            Face::Smooth { eta } | Face::Rough { eta, .. } => eta,
+        }
+    }
+    /// The face as core's rough dielectric and its scattering mode (a smooth
+    /// face is a `RoughDielectric` with `m = 0`); errors name the parameters
+    /// with `suffix` (`"_f"`, `"_b"`).
+    pub fn dielectric(&self, suffix: &str) -> Result<(RoughDielectric, FaceScattering), SlabError> {
+        let (eta, m, dist, fs) = match *self {
+            Face::Smooth { eta } => (eta, 0.0, Distribution::Ggx, FaceScattering::Single),
+            Face::Rough {
+                eta,
+                m,
+                dist,
+                scattering,
+            } => (eta, m, dist, scattering),
+        };
+        ParamError::check_range(&format!("m{suffix}"), m, M_RANGE.0, M_RANGE.1)?;
+        let bd = RoughDielectric::new(dist, eta, m).map_err(|e| e.with_suffix(suffix))?;
+        Ok((bd, fs))
+    }
+    /// The face of `sheet` on the back (`back = true`) or front, as [`Face::Rough`].
+    pub fn of_sheet(sheet: &Sheet, back: bool) -> Face {
+        let bd = sheet.face(back);
+        Face::Rough {
+            eta: bd.eta,
+            m: bd.m,
+            dist: bd.dist,
+            scattering: sheet.face_scattering,
         }
     }
 }
@@ -66,6 +110,12 @@ pub struct Discretisation {
     /// Thickness of the starting layer before doubling; `None` for
     /// [`default_start_thickness`].
     pub start_thickness: Option<f64>,
+    /// Gauss-Legendre points per panel of the azimuth rule that projects
+    /// rough faces ([`crate::interface`]), 2 to 64; default 8.
+    pub azimuth_points: usize,
+    /// Whether rough faces are normalised to core's directional albedo
+    /// ([`crate::interface`]); default `true`.
+    pub normalise_faces: bool,
 }
 
 impl Default for Discretisation {
@@ -75,6 +125,8 @@ impl Default for Discretisation {
             tir_nodes: 16,
             orders: 1,
             start_thickness: None,
+            azimuth_points: DEFAULT_AZIMUTH_POINTS,
+            normalise_faces: true,
         }
     }
 }
@@ -104,9 +156,40 @@ pub struct Solution {
     pub doublings: u32,
     /// The phase function's normalisation factors ([`crate::phase::PhaseFourier::scale`]).
     pub phase_scale: Vec<f64>,
+    /// The compensation of the front and back faces (`"multiple"` rough faces; [`crate::interface`]).
+    pub face_compensation: [Option<Compensation>; 2],
 }
 
 impl SlabSpec {
+    /// The sheet of `p` (docs/design.md 3; `paperbsdf_core::sheet`) in colour
+    /// channel `channel` (0 to 2; a scalar parameter is the same in every
+    /// channel): albedo `sigma_s / sigma_t` (0 when `sigma_t = 0`),
+    /// `tau = sigma_t d`, rough faces as [`Face::of_sheet`]. Faces of unequal
+    /// index are [`SlabError::Unsupported`].
+    pub fn from_params(p: &PaperParams, channel: usize) -> Result<SlabSpec, SlabError> {
+        if channel > 2 {
+            return Err(SlabError::Discretisation {
+                name: "channel",
+                value: channel as f64,
+                range: "0, 1 or 2",
+            });
+        }
+        let sheet = Sheet::from_params(p)?;
+        let (sa, ss) = (sheet.sigma_a.0[channel], sheet.sigma_s.0[channel]);
+        let st = sa + ss;
+        let spec = SlabSpec {
+            medium: Medium {
+                albedo: if st > 0.0 { ss / st } else { 0.0 },
+                tau: st * sheet.d,
+                phase: sheet.phase,
+            },
+            front: Face::of_sheet(&sheet, false),
+            back: Face::of_sheet(&sheet, true),
+        };
+        spec.validate()?;
+        Ok(spec)
+    }
+
     /// Checks every parameter (ranges named in the messages).
     pub fn validate(&self) -> Result<(), SlabError> {
         ParamError::check_range("albedo", self.medium.albedo, 0.0, 1.0)?;
@@ -114,6 +197,8 @@ impl SlabSpec {
         validate(&self.medium.phase)?;
         ParamError::check_range("eta_f", self.front.eta(), ETA_RANGE.0, ETA_RANGE.1)?;
         ParamError::check_range("eta_b", self.back.eta(), ETA_RANGE.0, ETA_RANGE.1)?;
+        self.front.dielectric("_f")?;
+        self.back.dielectric("_b")?;
         if self.front.eta() != self.back.eta() {
             return Err(SlabError::Unsupported(
                 "faces of different indices (eta_f != eta_b: the coated sheet of docs/design.md 4.1)",
@@ -143,18 +228,27 @@ impl SlabSpec {
         let inside = Grid::inside(&outside, self.front.eta(), disc.tir_nodes);
         let phase = phase_fourier(&self.medium.phase, &inside, disc.orders)?;
         let start = disc.start_thickness.unwrap_or_else(|| default_start_thickness(&inside));
-        let front = match self.front {
-            Face::Smooth { .. } => smooth_interface(&outside, &inside),
+        let project = |face: &Face, suffix: &str| -> Result<ProjectedFace, SlabError> {
+            let (bd, fs) = face.dielectric(suffix)?;
+            let proj = Projection {
+                orders: disc.orders,
+                azimuth_points: disc.azimuth_points,
+                normalise: disc.normalise_faces,
+            };
+            face_interface(&bd, fs, &outside, &inside, &proj)
         };
-        let back = match self.back {
-            Face::Smooth { .. } => smooth_interface(&outside, &inside).flipped(),
+        let front = project(&self.front, "_f")?;
+        let back = if self.back == self.front {
+            front.clone()
+        } else {
+            project(&self.back, "_b")?
         };
         let solved: Vec<(Layer, Layer, u32)> = (0..disc.orders)
             .into_par_iter()
             .map(|m| {
                 let (med, k) = medium_layer(&inside, &phase, m, self.medium.albedo, self.medium.tau, start)?;
                 let med = med.into_layer();
-                let sheet = front.add(&med)?.add(&back)?;
+                let sheet = front.orders[m].add(&med)?.add(&back.orders[m].flipped())?;
                 Ok((sheet, med, k))
             })
             .collect::<Result<_, SlabError>>()?;
@@ -167,6 +261,7 @@ impl SlabSpec {
             medium,
             doublings,
             phase_scale: phase.scale,
+            face_compensation: [front.compensation, back.compensation],
         })
     }
 }

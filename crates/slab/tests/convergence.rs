@@ -83,6 +83,7 @@ fn bsdf_converges_in_orders() {
                 tir_nodes: nodes / 2,
                 orders,
                 start_thickness: None,
+                ..Default::default()
             };
             let t0 = std::time::Instant::now();
             let sol = spec.solve(&disc).unwrap();

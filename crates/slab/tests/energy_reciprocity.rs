@@ -100,6 +100,7 @@ fn matrices_are_reciprocal_in_every_order() {
         tir_nodes: 10,
         orders: 12,
         start_thickness: None,
+        ..Default::default()
     };
     let mut worst: f64 = 0.0;
     for (albedo, tau, phase, eta) in [
@@ -127,6 +128,7 @@ fn a_homogeneous_sheet_looks_the_same_from_both_sides() {
         tir_nodes: 8,
         orders: 4,
         start_thickness: None,
+        ..Default::default()
     };
     let sol = sheet(0.95, 4.0, PAPER_PHASE, 1.5).solve(&disc).unwrap();
     for l in &sol.orders {

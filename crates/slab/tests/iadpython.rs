@@ -49,6 +49,7 @@ fn compare(path: &str, tol: impl Fn(&str, f64, f64) -> f64) -> f64 {
         tir_nodes: 16,
         orders: 1,
         start_thickness: None,
+        ..Default::default()
     };
     let (mut worst, mut failures) = (0.0f64, Vec::new());
     for row in &rows {

@@ -1,0 +1,195 @@
+//! (a) A rough face alone: the order-0 albedo of its projected matrices from
+//! each side against core's quadrature of the same face, and energy
+//! conservation of the compensated (`"multiple"`) face; (b) reciprocity of
+//! the projected matrices, with the `eta^2` of generalised reciprocity, in
+//! every order.
+//!
+//! Reference: `paperbsdf_core::boundary::directional_albedo_n` (Walter's
+//! `R` and `T` by a 128 x 128 Gauss-Legendre rule in the square of visible
+//! normals; it converges slowly itself, within 4e-4 of its 256-point rule for
+//! m <= 0.5 and 1.2e-3 at m = 1, measured), from outside at each
+//! outside node and from inside at each inside node.
+//!
+//! The projection's error is that of the grids' quadrature in `mu` of a lobe
+//! (the azimuth rule is converged: tests/rough_convergence.rs): the
+//! refraction lobe ends with a kink where the microfacet turns its back to a
+//! direction, which falls anywhere between nodes. Measured with 32 outside
+//! nodes (16 in the cone of total internal reflection), eta = 1.5, largest
+//! over the nodes: the raw projection's `R` and `T` are within 3.0e-2 of
+//! core's (GGX m = 0.15 at normal incidence, the narrowest lobe; 7e-3 for
+//! m = 0.3, 1.2e-2 for 0.5); normalised to core's `R + T` (the solver's
+//! default) the split is within 1.0e-3 from outside and 5.1e-3 from inside
+//! (GGX m = 0.5; 2.1e-3 at m = 0.15; GGX m = 0.3: 9.7e-4, 3.3e-3; Beckmann
+//! m = 0.15: 1.4e-4, 3.2e-3, m = 0.3: 1.1e-4, 1.8e-3). Asked: raw 4e-2,
+//! normalised 2e-3 from outside and 6e-3 from inside.
+//!
+//! With `"multiple"` faces every node's `R + T` is 1 within 1e-12 (the
+//! normalisation's tolerance; measured 9e-13), far inside issue 14's 2e-3,
+//! and `k_o` is core's (`PaperBsdf::face_compensation`) exactly; `k_i`,
+//! which follows from the `Lbar` of the grid instead of core's tables, is
+//! within 0.4% of core's.
+
+use nalgebra::DMatrix;
+use paperbsdf_core::boundary::{dir_at_mu, directional_albedo_n};
+use paperbsdf_core::{Distribution, FaceScattering, RoughDielectric};
+use paperbsdf_slab::interface::{face_interface, Projection};
+use paperbsdf_slab::{Grid, Layer};
+
+/// `sum_o w_o mu_o K[o][j] / (w_j mu_j)`.
+fn albedo(k: &DMatrix<f64>, to: &Grid, from: &Grid, j: usize) -> f64 {
+    (0..to.len()).map(|o| to.w[o] * to.mu[o] * k[(o, j)]).sum::<f64>() / (from.w[j] * from.mu[j])
+}
+
+fn grids(eta: f64, nodes: usize) -> (Grid, Grid) {
+    let out = Grid::outside(nodes);
+    let ins = Grid::inside(&out, eta, nodes / 2);
+    (out, ins)
+}
+
+/// Core's `(R, T)` at every outside node (from outside) and inside node (from inside).
+/// Core's `(R, T)` from outside at the outside nodes and from inside at the inside nodes.
+type References = (Vec<(f64, f64)>, Vec<(f64, f64)>);
+
+fn references(bd: &RoughDielectric, out: &Grid, ins: &Grid) -> References {
+    let at = |g: &Grid, side: f64| -> Vec<(f64, f64)> {
+        g.mu.iter()
+            .map(|&mu| directional_albedo_n(bd, dir_at_mu(mu, side), REFERENCE_POINTS))
+            .collect()
+    };
+    (at(out, 1.0), at(ins, -1.0))
+}
+
+/// Points per axis of core's rule for the references (as the normalisation's targets,
+/// [`paperbsdf_slab::interface::ALBEDO_POINTS`]; within 4e-4 of the 256-point rule for m <= 0.5).
+const REFERENCE_POINTS: usize = 128;
+
+/// Largest `|R - R_core|`, `|T - T_core|` over the nodes from outside and from inside.
+fn albedo_errors(refs: &References, l: &Layer, out: &Grid, ins: &Grid) -> (f64, f64) {
+    let (mut e_out, mut e_in): (f64, f64) = (0.0, 0.0);
+    for (j, (r, t)) in refs.0.iter().enumerate() {
+        let (rp, tp) = (albedo(&l.r_top, out, out, j), albedo(&l.t_down, ins, out, j));
+        e_out = e_out.max((rp - r).abs()).max((tp - t).abs());
+    }
+    for (j, (r, t)) in refs.1.iter().enumerate() {
+        let (rp, tp) = (albedo(&l.r_bot, ins, ins, j), albedo(&l.t_up, out, ins, j));
+        e_in = e_in.max((rp - r).abs()).max((tp - t).abs());
+    }
+    (e_out, e_in)
+}
+
+#[test]
+fn single_face_albedo_matches_cores_quadrature() {
+    let (out, ins) = grids(1.5, 32);
+    // GGX m = 0.3 and Beckmann m = 0.15 measured as well (module doc), left out for time
+    for (dist, m) in [
+        (Distribution::Ggx, 0.15),
+        (Distribution::Ggx, 0.5),
+        (Distribution::Beckmann, 0.3),
+    ] {
+        let bd = RoughDielectric::new(dist, 1.5, m).unwrap();
+        let refs = references(&bd, &out, &ins);
+        let raw = face_interface(&bd, FaceScattering::Single, &out, &ins, &proj_raw(1, 8)).unwrap();
+        let (r_out, r_in) = albedo_errors(&refs, &raw.orders[0], &out, &ins);
+        let face = face_interface(&bd, FaceScattering::Single, &out, &ins, &proj(1, 8)).unwrap();
+        let (e_out, e_in) = albedo_errors(&refs, &face.orders[0], &out, &ins);
+        let s_dev = face.scale.iter().map(|s| (s - 1.0).abs()).fold(0.0, f64::max);
+        println!(
+            "{dist:?} m = {m}: largest |albedo - core|, raw projection: from outside {r_out:.1e}, from inside {r_in:.1e}; normalised (largest |s - 1| {s_dev:.1e}): {e_out:.1e}, {e_in:.1e}"
+        );
+        assert!(r_out < 0.04 && r_in < 0.04, "{dist:?} m={m}: {r_out} {r_in}");
+        assert!(e_out < 2e-3 && e_in < 6e-3, "{dist:?} m={m}: {e_out} {e_in}");
+    }
+}
+
+#[test]
+fn multiple_face_conserves_energy_and_keeps_cores_shares() {
+    let (out, ins) = grids(1.5, 32);
+    for (dist, m) in [
+        (Distribution::Ggx, 0.15),
+        (Distribution::Ggx, 0.5),
+        (Distribution::Beckmann, 0.3),
+    ] {
+        {
+            let bd = RoughDielectric::new(dist, 1.5, m).unwrap();
+            let face = face_interface(&bd, FaceScattering::Multiple, &out, &ins, &proj(1, 8)).unwrap();
+            let l = &face.orders[0];
+            let c = face.compensation.as_ref().unwrap();
+            let mut worst: f64 = 0.0;
+            for j in 0..out.len() {
+                let s = albedo(&l.r_top, &out, &out, j) + albedo(&l.t_down, &ins, &out, j);
+                worst = worst.max((s - 1.0).abs());
+            }
+            for j in 0..ins.len() {
+                let s = albedo(&l.r_bot, &ins, &ins, j) + albedo(&l.t_up, &out, &ins, j);
+                worst = worst.max((s - 1.0).abs());
+            }
+            // core's shares for the same face (its tables' Lbar in place of the grid's)
+            let params = paperbsdf_core::PaperParams {
+                eta_f: 1.5,
+                eta_b: 1.5,
+                m_f: m,
+                m_b: m,
+                dist_f: dist,
+                dist_b: dist,
+                face_scattering: FaceScattering::Multiple,
+                ..paperbsdf_core::presets::matte_office()
+            };
+            let model = paperbsdf_core::PaperBsdf::new(&params).unwrap();
+            let (k_o, k_i) = model.face_compensation(paperbsdf_core::paper::Side::Front);
+            println!(
+                "{dist:?} m = {m}: |R + T - 1| <= {worst:.1e}, clipped {:.1e}; Lbar_o {:.4}, Lbar_i {:.4}; k_o {:.4} (core {k_o:.4}), k_i {:.4} (core {k_i:.4})",
+                c.clipped, c.lbar_out, c.lbar_in, c.k_out, c.k_in
+            );
+            assert!(worst < 1e-11, "{worst}");
+            assert!((c.k_out - k_o).abs() < 1e-12 && (c.k_in - k_i).abs() < 0.01 * k_i.max(0.01));
+        }
+    }
+}
+
+/// Largest asymmetry of `W_a K_ab` against `(W_b K_ba)^T`, relative to the largest entry.
+fn asymmetry(wa: &[f64], kab: &DMatrix<f64>, wb: &[f64], kba: &DMatrix<f64>) -> f64 {
+    let a = DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(wa)) * kab;
+    let b = DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(wb)) * kba;
+    (&a - b.transpose()).amax() / a.amax().max(b.amax()).max(1e-300)
+}
+
+fn layer_asymmetry(l: &Layer, top: &Grid, bot: &Grid) -> f64 {
+    let (wt, wb) = (top.reciprocity_weights(), bot.reciprocity_weights());
+    asymmetry(&wt, &l.r_top, &wt, &l.r_top)
+        .max(asymmetry(&wb, &l.r_bot, &wb, &l.r_bot))
+        .max(asymmetry(&wb, &l.t_down, &wt, &l.t_up))
+}
+
+#[test]
+fn projected_faces_are_reciprocal_in_every_order() {
+    let (out, ins) = grids(1.5, 20);
+    let mut worst: f64 = 0.0;
+    for dist in [Distribution::Ggx, Distribution::Beckmann] {
+        for fs in [FaceScattering::Single, FaceScattering::Multiple] {
+            for m in [0.1, 0.4] {
+                let bd = RoughDielectric::new(dist, 1.5, m).unwrap();
+                let face = face_interface(&bd, fs, &out, &ins, &proj(12, 8)).unwrap();
+                for l in &face.orders {
+                    worst = worst.max(layer_asymmetry(l, &out, &ins));
+                }
+            }
+        }
+    }
+    println!("worst relative asymmetry of the projected faces (12 orders): {worst:.2e}");
+    assert!(worst < 1e-10, "{worst}");
+}
+
+fn proj(orders: usize, azimuth_points: usize) -> Projection {
+    Projection {
+        orders,
+        azimuth_points,
+        normalise: true,
+    }
+}
+
+fn proj_raw(orders: usize, azimuth_points: usize) -> Projection {
+    Projection {
+        normalise: false,
+        ..proj(orders, azimuth_points)
+    }
+}
