@@ -35,7 +35,7 @@
 //! The back face (`z = -d`) is the same kind of object seen with `z` flipped:
 //! [`to_face_frame`] maps a direction on the back side to the face's frame.
 
-use super::tables::{hemispherical, hemispherical_of_table, lerp_mu, lerp_nodes, node_at, NA};
+use super::tables::{hemispherical, hemispherical_of_table, hemispherical_pair, lerp_mu, lerp_nodes, node_at, NA};
 use super::Side;
 use crate::boundary::{critical_mu, SurfaceIntegrals};
 use crate::dielectric::{Interface, RoughDielectric};
@@ -98,7 +98,14 @@ impl Interface4 {
             comp: false,
         };
         if fs == FaceScattering::Multiple && matches!(bd.interface, Interface::Rough(_)) {
-            let lbar_o = 1.0 - hemispherical(|mu| me.si.att(mu) + me.si.r_out(mu), 0.0);
+            let lbar_o = 1.0
+                - hemispherical(
+                    |mu| {
+                        let (att, r_out) = me.si.att_r_out(mu);
+                        att + r_out
+                    },
+                    0.0,
+                );
             let lbar_i = (1.0 - me.si.rho_in - me.si.tbar_in).max(0.0);
             let lost = crate::microsurface_tables::lost_energy(bd.dist, bd.eta, bd.m);
             let tot = lost.t_out2 + lost.r_out2;
@@ -128,54 +135,41 @@ impl Interface4 {
         me
     }
 
-    /// Walter's reflectance from outside (the closed-form lobe's albedo), or Fresnel.
-    fn r_walter(&self, mu: f64) -> f64 {
+    /// For light from outside at `mu`: `(T_w, R_w, L_o)`, Walter's
+    /// transmittance (the collimated part) and reflectance (the closed-form
+    /// lobe's albedo, or Fresnel) and the energy `L_o` his interface loses
+    /// (0 without the compensation), from one lookup of the tables.
+    #[inline]
+    fn outside(&self, mu: f64) -> (f64, f64, f64) {
         match self.kind {
-            Interface::IndexMatched => 0.0,
-            Interface::Smooth => fresnel_dielectric(mu, self.eta),
-            Interface::Rough(_) => self.si.r_out(mu),
+            Interface::IndexMatched => (1.0, 0.0, 0.0),
+            Interface::Smooth => {
+                let f = fresnel_dielectric(mu, self.eta);
+                (1.0 - f, f, 0.0)
+            }
+            Interface::Rough(_) => {
+                let (att, r_out) = self.si.att_r_out(mu);
+                let lost = if self.comp { (1.0 - att - r_out).max(0.0) } else { 0.0 };
+                (att, r_out, lost)
+            }
         }
     }
-    /// Walter's transmittance from outside (the collimated part).
-    fn t_walter(&self, mu: f64) -> f64 {
+    /// For light from inside at inner cosine `mu`: `(R_in, T_in)`, the
+    /// reflectance (TIR included) and transmittance, all orders.
+    #[inline]
+    fn inside(&self, mu: f64) -> (f64, f64) {
         match self.kind {
-            Interface::IndexMatched => 1.0,
-            Interface::Smooth => 1.0 - fresnel_dielectric(mu, self.eta),
-            Interface::Rough(_) => self.si.att(mu),
-        }
-    }
-    /// Energy lost by Walter's interface for light from outside at `mu`.
-    fn lost_out(&self, mu: f64) -> f64 {
-        if !self.comp {
-            return 0.0;
-        }
-        (1.0 - self.si.att(mu) - self.si.r_out(mu)).max(0.0)
-    }
-    /// Energy lost for light from inside at inner cosine `mu`.
-    fn lost_in(&self, mu: f64) -> f64 {
-        if !self.comp {
-            return 0.0;
-        }
-        (1.0 - self.si.r_in(mu) - self.si.t_in(mu)).max(0.0)
-    }
-    /// Transmittance from outside, all orders.
-    fn t_out(&self, mu: f64) -> f64 {
-        self.t_walter(mu) + self.k.0 * self.lost_out(mu)
-    }
-    /// Reflectance from inside at inner cosine `mu` (TIR included), all orders.
-    fn r_in(&self, mu: f64) -> f64 {
-        match self.kind {
-            Interface::IndexMatched => 0.0,
-            Interface::Smooth => fresnel_dielectric(-mu, self.eta),
-            Interface::Rough(_) => self.si.r_in(mu) + (1.0 - self.k.1) * self.lost_in(mu),
-        }
-    }
-    /// Transmittance from inside at inner cosine `mu`, all orders.
-    fn t_in(&self, mu: f64) -> f64 {
-        match self.kind {
-            Interface::IndexMatched => 1.0,
-            Interface::Smooth => 1.0 - fresnel_dielectric(-mu, self.eta),
-            Interface::Rough(_) => self.si.t_in(mu) + self.k.1 * self.lost_in(mu),
+            Interface::IndexMatched => (0.0, 1.0),
+            Interface::Smooth => {
+                let f = fresnel_dielectric(-mu, self.eta);
+                (f, 1.0 - f)
+            }
+            Interface::Rough(_) => {
+                let (r, t) = self.si.r_t_in(mu);
+                // The energy lost by Walter's interface from inside.
+                let lost = if self.comp { (1.0 - r - t).max(0.0) } else { 0.0 };
+                (r + (1.0 - self.k.1) * lost, t + self.k.1 * lost)
+            }
         }
     }
     /// `(rho_in, Tbar_in)` for diffuse light from inside, all orders.
@@ -314,22 +308,24 @@ impl Face {
         for k in 0..NA {
             let t = k as f64 / (NA - 1) as f64;
             let mu = t * t;
-            let lo = ifc.lost_out(mu);
+            let (t_w, r_w, lo) = ifc.outside(mu);
             comp_e[k] = lo;
-            let (t_r, t_w) = (ifc.t_out(mu), ifc.t_walter(mu));
-            let r_r = ifc.r_walter(mu) + (1.0 - ifc.k.0) * lo;
+            // Transmittance from outside, all orders.
+            let t_r = t_w + ifc.k.0 * lo;
+            let r_r = r_w + (1.0 - ifc.k.0) * lo;
             let (att, att_dir, r_coat) = match coating {
                 None => (t_r, t_w, 0.0),
                 Some(nu) => {
                     // Inside the coating at the smooth refraction of mu through eta.
                     let mu_c = refracted_cos(mu, eta).unwrap_or(0.0);
                     let fs_ = fresnel_dielectric(mu_c, nu);
-                    let denom = 1.0 - fs_ * ifc.r_in(mu_c);
+                    let (r_in, t_in) = ifc.inside(mu_c);
+                    let denom = 1.0 - fs_ * r_in;
                     if denom <= 0.0 {
                         (0.0, 0.0, t_r)
                     } else {
                         let g = (1.0 - fs_) / denom;
-                        (t_r * g, t_w * g, t_r * fs_ * ifc.t_in(mu_c) / denom)
+                        (t_r * g, t_w * g, t_r * fs_ * t_in / denom)
                     }
                 }
             };
@@ -362,19 +358,16 @@ impl Face {
                         return (1.0, 0.0);
                     };
                     let fs_ = fresnel_dielectric(mu_c, nu);
-                    let r = ifc.r_in(mu_c);
+                    let (r, t_in) = ifc.inside(mu_c);
                     let denom = 1.0 - fs_ * r;
                     if denom <= 0.0 {
                         return (1.0, 0.0);
                     }
-                    (
-                        fs_ + (1.0 - fs_) * (1.0 - fs_) * r / denom,
-                        (1.0 - fs_) * ifc.t_in(mu_c) / denom,
-                    )
+                    (fs_ + (1.0 - fs_) * (1.0 - fs_) * r / denom, (1.0 - fs_) * t_in / denom)
                 };
                 // Kinks: TIR at the smooth boundary and at the rough face's critical angle, seen from the base.
                 let mu_k = critical_mu(n / eta.min(n)).max(critical_mu(n));
-                (hemispherical(|m| one(m).0, mu_k), hemispherical(|m| one(m).1, mu_k))
+                hemispherical_pair(one, mu_k)
             }
         };
         f.rho_in = rho.clamp(0.0, 1.0);

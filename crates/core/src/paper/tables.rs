@@ -70,10 +70,17 @@ pub(crate) fn hemispherical_of_table(tab: &[f64; NA]) -> f64 {
 /// on `[0, t_c]` and `[t_c, 1]` (a kink of total internal reflection at
 /// `mu = t_c^2` falls on the split).
 pub(crate) fn hemispherical(g: impl Fn(f64) -> f64, mu_split: f64) -> f64 {
+    hemispherical_pair(|mu| (g(mu), 0.0), mu_split).0
+}
+
+/// [`hemispherical`] of the two functions `g` returns, on the same points
+/// (each sum as [`hemispherical`] would form it): for pairs of integrands
+/// that share their work.
+pub(crate) fn hemispherical_pair(g: impl Fn(f64) -> (f64, f64), mu_split: f64) -> (f64, f64) {
     static GL: std::sync::OnceLock<(Vec<f64>, Vec<f64>)> = std::sync::OnceLock::new();
     let (x, w) = GL.get_or_init(|| gauss_legendre_01(24));
     let tc = mu_split.clamp(0.0, 1.0).sqrt();
-    let mut s = 0.0;
+    let (mut s0, mut s1) = (0.0, 0.0);
     for (lo, hi) in [(0.0, tc), (tc, 1.0)] {
         let len = hi - lo;
         if len <= 0.0 {
@@ -81,8 +88,10 @@ pub(crate) fn hemispherical(g: impl Fn(f64) -> f64, mu_split: f64) -> f64 {
         }
         for (xi, wi) in x.iter().zip(w) {
             let t = lo + len * xi;
-            s += wi * len * 4.0 * t * t * t * g(t * t);
+            let (a, b) = g(t * t);
+            s0 += wi * len * 4.0 * t * t * t * a;
+            s1 += wi * len * 4.0 * t * t * t * b;
         }
     }
-    s
+    (s0, s1)
 }
