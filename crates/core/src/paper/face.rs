@@ -35,7 +35,7 @@
 //! The back face (`z = -d`) is the same kind of object seen with `z` flipped:
 //! [`to_face_frame`] maps a direction on the back side to the face's frame.
 
-use super::tables::{hemispherical, hemispherical_of_table, hemispherical_pair, lerp_mu, lerp_nodes, node_at, NA};
+use super::tables::{hemispherical, hemispherical_of_table, hemispherical_pair, lerp_mu, lerp_nodes, TabPos, NA};
 use super::Side;
 use crate::boundary::{critical_mu, SurfaceIntegrals};
 use crate::dielectric::{Interface, RoughDielectric};
@@ -404,25 +404,37 @@ impl Face {
     /// [`Face::att`] at `mu` given also `st = sqrt(min(|mu|, 1))`.
     #[inline]
     pub fn att_with_sqrt(&self, st: f64) -> f64 {
+        self.att_at(TabPos::new(st))
+    }
+
+    /// [`Face::att`] at the place `p` of `mu` on the tables.
+    #[inline(always)]
+    pub fn att_at(&self, p: TabPos) -> f64 {
         if !self.use_att {
             return 1.0;
         }
         if self.exact_smooth {
-            return 1.0 - fresnel_dielectric(st * st, self.bd.eta);
+            return 1.0 - fresnel_dielectric(p.st * p.st, self.bd.eta);
         }
-        lerp_nodes(&self.att_tab, st)
+        p.lerp(&self.att_tab)
     }
 
     /// The collimated part of [`Face::att`] (what direct transmission carries), given `st`.
     #[inline]
     pub fn att_dir_with_sqrt(&self, st: f64) -> f64 {
+        self.att_dir_at(TabPos::new(st))
+    }
+
+    /// [`Face::att_dir_with_sqrt`] at the place `p` of `mu` on the tables.
+    #[inline(always)]
+    pub fn att_dir_at(&self, p: TabPos) -> f64 {
         if !self.use_att {
             return 1.0;
         }
         if self.exact_smooth {
-            return 1.0 - fresnel_dielectric(st * st, self.bd.eta);
+            return 1.0 - fresnel_dielectric(p.st * p.st, self.bd.eta);
         }
-        lerp_nodes(&self.att_dir_tab, st)
+        p.lerp(&self.att_dir_tab)
     }
 
     /// Directional reflectance for light from outside at cosine `mu`, every
@@ -501,7 +513,7 @@ impl Face {
     /// given `c2` in `(0, 1]`, with the interface's `1 / eta^2` in place of a
     /// division. From `c2`, the square roots of `c` and of the refracted
     /// cosine are independent and run side by side rather than one after the other.
-    #[inline]
+    #[inline(always)]
     pub fn fresnel_outside_sq(&self, c2: f64) -> f64 {
         if self.bd.eta == 1.0 {
             return 0.0;
@@ -555,15 +567,16 @@ impl Face {
         self.iface_k
     }
 
-    /// The separable lobes' reflection `sum_j c_j E_j(mu_i) E_j(mu_o)`, given `st = sqrt(mu)` of both.
-    #[inline]
-    pub fn lobes_reflection(&self, si: f64, so: f64) -> f64 {
-        let node = |st: f64| {
-            let (i, f) = node_at::<NA>(st);
+    /// The separable lobes' reflection `sum_j c_j E_j(mu_i) E_j(mu_o)`, given
+    /// the places of both cosines on the tables.
+    #[inline(always)]
+    pub fn lobes_reflection(&self, pi: TabPos, po: TabPos) -> f64 {
+        let node = |p: TabPos| {
+            let (i, f) = (p.i, p.f);
             let (a, b) = (self.lobe_tab[i], self.lobe_tab[i + 1]);
             [a[0] * (1.0 - f) + b[0] * f, a[1] * (1.0 - f) + b[1] * f]
         };
-        let (a, b) = (node(si), node(so));
+        let (a, b) = (node(pi), node(po));
         a[0] * b[0] + a[1] * b[1]
     }
 
@@ -572,14 +585,19 @@ impl Face {
     /// separable lobes; zero for a face without microfacets (its reflection is a delta).
     #[inline]
     pub fn reflection(&self, wi: DVec3, wo: DVec3) -> f64 {
-        self.reflection_with_sqrt(wi, wo, wi.z.min(1.0).sqrt(), wo.z.min(1.0).sqrt())
+        self.reflection_at(
+            wi,
+            wo,
+            TabPos::new(wi.z.min(1.0).sqrt()),
+            TabPos::new(wo.z.min(1.0).sqrt()),
+        )
     }
 
-    /// [`Face::reflection`] given also `si = sqrt(min(wi.z, 1))` and
-    /// `so = sqrt(min(wo.z, 1))` (the separable lobes' table coordinates),
-    /// which the callers already have.
-    #[inline]
-    pub fn reflection_with_sqrt(&self, wi: DVec3, wo: DVec3, si: f64, so: f64) -> f64 {
+    /// [`Face::reflection`] given also the places `pi`, `po` of `wi.z` and
+    /// `wo.z` on the tables (the separable lobes' coordinates), which the
+    /// callers already have.
+    #[inline(always)]
+    pub fn reflection_at(&self, wi: DVec3, wo: DVec3, pi: TabPos, po: TabPos) -> f64 {
         let Interface::Rough(mf) = self.bd.interface else {
             return 0.0;
         };
@@ -589,13 +607,13 @@ impl Face {
         let lobes = if self.lobes.is_empty() {
             0.0
         } else {
-            self.lobes_reflection(si, so)
+            self.lobes_reflection(pi, po)
         };
         self.fresnel_outside_sq(oh2) * mf.reflection_dg_c2(c2, wi.z, wo.z) + lobes
     }
 
     /// Density of [`Face::sample_reflection`]: `pdf_visible(wo, h) / (4 |wo.h|)`.
-    #[inline]
+    #[inline(always)]
     pub fn reflection_pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
         let Some(mf) = self.microfacet() else { return 0.0 };
         let Some((c2, _)) = reflection_half(wi, wo) else {
@@ -606,9 +624,9 @@ impl Face {
 
     /// `(f_r, pdf)`: [`Face::reflection`] and [`Face::reflection_pdf`] at once,
     /// sharing `D(h)` and the masking of `wo` (for `sample`, which needs both);
-    /// `si`, `so` as in [`Face::reflection_with_sqrt`].
-    #[inline]
-    pub fn reflection_and_pdf(&self, wi: DVec3, wo: DVec3, si: f64, so: f64) -> (f64, f64) {
+    /// `pi`, `po` as in [`Face::reflection_at`].
+    #[inline(always)]
+    pub fn reflection_and_pdf(&self, wi: DVec3, wo: DVec3, pi: TabPos, po: TabPos) -> (f64, f64) {
         let Interface::Rough(mf) = self.bd.interface else {
             return (0.0, 0.0);
         };
@@ -619,7 +637,7 @@ impl Face {
         let lobes = if self.lobes.is_empty() {
             0.0
         } else {
-            self.lobes_reflection(si, so)
+            self.lobes_reflection(pi, po)
         };
         (self.fresnel_outside_sq(oh2) * dg + lobes, pdf)
     }

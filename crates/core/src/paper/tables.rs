@@ -32,8 +32,45 @@ where
 #[inline(always)]
 pub(crate) fn node_at<const N: usize>(st: f64) -> (usize, f64) {
     let x = st * (N - 1) as f64;
-    let i = (x as usize).min(N - 2);
+    // `(x as i32).max(0) as usize` is `x as usize` for every `x` once capped
+    // at `N - 2` (NaN and negatives give 0, large values the cap), in fewer
+    // instructions: x86-64 converts to signed integers only.
+    let i = ((x as i32).max(0) as usize).min(N - 2);
     (i, x - i as f64)
+}
+
+/// A cosine's place on the [`NA`]-node tables: `st = sqrt(min(|mu|, 1))` with
+/// the interval and fraction of [`node_at`], found once per direction and
+/// shared by every table read there ([`TabPos::lerp`] is [`lerp_nodes`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TabPos {
+    /// `sqrt(min(|mu|, 1))`.
+    pub st: f64,
+    /// The interval: nodes `i` and `i + 1`.
+    pub i: usize,
+    /// The fraction of the way from node `i` to node `i + 1`.
+    pub f: f64,
+}
+
+impl TabPos {
+    /// The place of grazing (`st = 0`), for callers that read no table.
+    pub const ZERO: TabPos = TabPos { st: 0.0, i: 0, f: 0.0 };
+
+    /// The place of `st = sqrt(min(|mu|, 1))`.
+    #[inline(always)]
+    pub fn new(st: f64) -> Self {
+        let (i, f) = node_at::<NA>(st);
+        TabPos { st, i, f }
+    }
+
+    /// [`lerp_nodes`] of `tab` at this place.
+    #[inline(always)]
+    pub fn lerp<T>(&self, tab: &[T; NA]) -> T
+    where
+        T: Copy + Mul<f64, Output = T> + Add<Output = T>,
+    {
+        tab[self.i] * (1.0 - self.f) + tab[self.i + 1] * self.f
+    }
 }
 
 /// Linear interpolation of a node table (of numbers or colours) at
