@@ -268,6 +268,10 @@ impl PaperBsdf {
     }
 
     /// The mixture density; `surface_pdf` is the face's reflection density if the caller has it.
+    ///
+    /// Always inlined: `sample` and `pdf` then share its side and face
+    /// lookups and tests with their own.
+    #[inline(always)]
     pub(super) fn pdf_with(
         &self,
         wi: DVec3,
