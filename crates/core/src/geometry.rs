@@ -71,6 +71,27 @@ pub fn coordinate_system(n: DVec3) -> (DVec3, DVec3) {
     )
 }
 
+/// `y.round()` (halves away from zero), bit for bit, without the library
+/// call that x86-64's baseline instruction set needs for it: below `2^52`
+/// the truncation `t` is exact through a conversion to `i64`, and so is
+/// `y - t`; from `2^52` on (and for NaN and infinities) `y` is its own rounding.
+#[inline(always)]
+fn round_half_away(y: f64) -> f64 {
+    if y.is_nan() || y.abs() >= 4_503_599_627_370_496.0 {
+        return y;
+    }
+    let t = y as i64 as f64;
+    let d = y - t;
+    if d >= 0.5 {
+        t + 1.0
+    } else if d <= -0.5 {
+        t - 1.0
+    } else {
+        // The sign of a zero as `round` gives it (`-0.3` rounds to `-0`).
+        t.copysign(y)
+    }
+}
+
 /// `(sin 2 pi u, cos 2 pi u)` for `u` in `[0, 1]`, faster than `f64::sin_cos`
 /// for the azimuths of samplers: the turn is reduced to a quarter-turn index
 /// and an angle `x` in `[-pi/4, pi/4]`, where the Taylor series of `sin` to
@@ -78,7 +99,7 @@ pub fn coordinate_system(n: DVec3) -> (DVec3, DVec3) {
 /// below `1e-19`). Within a few ulps of `f64::sin_cos` (tested).
 #[inline]
 pub fn sin_cos_2pi(u: f64) -> (f64, f64) {
-    let q = (4.0 * u).round();
+    let q = round_half_away(4.0 * u);
     let x = std::f64::consts::TAU * (u - 0.25 * q);
     let x2 = x * x;
     // 1/n! for the odd and even terms.
@@ -129,6 +150,34 @@ pub fn sample_uniform_sphere(u: [f64; 2]) -> DVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The rounding of [`sin_cos_2pi`] against `f64::round`, bit for bit:
+    /// halves, neighbours of halves, signed zeros, large values, NaN.
+    #[test]
+    fn round_half_away_matches_std() {
+        let mut xs = vec![0.0, -0.0, 0.5, -0.5, 1.5, -1.5, 2.5, 3.5, 4.0, 0.3, -0.3, 0.7, -0.7];
+        for h in [0.5f64, 1.5, 2.5, 3.5, 1e15 + 0.5, 4_503_599_627_370_495.5] {
+            for x in [h, -h] {
+                xs.extend([x, f64::from_bits(x.to_bits() + 1), f64::from_bits(x.to_bits() - 1)]);
+            }
+        }
+        xs.extend([
+            4_503_599_627_370_496.0,
+            1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MIN_POSITIVE,
+            5e-324,
+        ]);
+        for k in 0..=40_000 {
+            xs.push(k as f64 / 10_000.0);
+            xs.push(4.0 * (k as f64 + 0.37) / 40_000.0);
+        }
+        for x in xs {
+            assert_eq!(round_half_away(x).to_bits(), x.round().to_bits(), "{x:e}");
+        }
+        assert!(round_half_away(f64::NAN).is_nan());
+    }
 
     /// The reduced Taylor series against the standard library over the whole
     /// turn, quarter-turn boundaries included.

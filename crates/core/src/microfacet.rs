@@ -162,10 +162,11 @@ impl Microfacet {
 
     /// [`Microfacet::reflection_dg`] from `c2 = h.z^2` and the cosines alone
     /// (see [`Microfacet::reflection_dg_pdf_c2`]), without the density.
-    #[inline]
+    #[inline(always)]
     pub fn reflection_dg_c2(&self, c2: f64, ci: f64, co: f64) -> f64 {
-        // The density is dead code here and compiled away once inlined.
-        self.reflection_dg_pdf_c2(c2, ci, co).0
+        // Without the density: Beckmann's needs erf and exp, calls that the
+        // compiler cannot drop as unused.
+        self.reflection_dg_maybe_pdf_c2::<false>(c2, ci, co).0
     }
 
     /// `(D G1(wi) G1(wo) / (4 wi.z wo.z), G1_exact(wo) D / (4 wo.z))`: the
@@ -185,8 +186,15 @@ impl Microfacet {
     /// `ci = wi.z`, `co = wo.z` alone (for reflection nothing else of `h` is
     /// needed, and `c2 = (ci + co)^2 / (2 (1 + wi.wo))` needs no square root).
     /// Shares `D` and the masking of `wo` between the two, with few divisions.
-    #[inline]
+    #[inline(always)]
     pub fn reflection_dg_pdf_c2(&self, c2: f64, ci: f64, co: f64) -> (f64, f64) {
+        self.reflection_dg_maybe_pdf_c2::<true>(c2, ci, co)
+    }
+
+    /// [`Microfacet::reflection_dg_pdf_c2`], with the density only if `PDF`
+    /// (else 0).
+    #[inline(always)]
+    fn reflection_dg_maybe_pdf_c2<const PDF: bool>(&self, c2: f64, ci: f64, co: f64) -> (f64, f64) {
         if c2 <= 0.0 || ci <= 0.0 || co <= 0.0 {
             return (0.0, 0.0);
         }
@@ -209,10 +217,12 @@ impl Microfacet {
                     return (0.0, 0.0);
                 }
                 let pi_a2 = PI * a2;
-                (
-                    d * g / (pi_a2 * den),
-                    d / (pi_a2 * 4.0 * co * (1.0 + beckmann_lambda_a(ao))),
-                )
+                let pdf = if PDF {
+                    d / (pi_a2 * 4.0 * co * (1.0 + beckmann_lambda_a(ao)))
+                } else {
+                    0.0
+                };
+                (d * g / (pi_a2 * den), pdf)
             }
         }
     }
@@ -222,7 +232,7 @@ impl Microfacet {
     /// denominator, a)`, so that callers can merge divisions, with the
     /// `a = cot(theta) / alpha` it used (infinite at normal incidence), which
     /// also gives Lambda ([`beckmann_lambda_a`]).
-    #[inline]
+    #[inline(always)]
     fn beckmann_g1_ratio(&self, c: f64) -> (f64, f64, f64) {
         let s2 = (1.0 - c * c).max(0.0);
         if s2 == 0.0 {
@@ -241,11 +251,14 @@ impl Microfacet {
     /// (Walter's rational `G1`) and `a_o = cot(theta_o) / alpha`, the same
     /// quantities as [`Microfacet::d`] and [`Microfacet::g1`], left for the
     /// caller to divide once.
-    #[inline]
+    #[inline(always)]
     fn beckmann_parts(&self, c2: f64, ci: f64, co: f64) -> (f64, f64, f64, f64) {
         let a2 = self.alpha * self.alpha;
         let inv_c2 = 1.0 / c2;
-        let e = (-(1.0 - c2).max(0.0) * inv_c2 / a2).exp();
+        let x = -(1.0 - c2).max(0.0) * inv_c2 / a2;
+        // Below EXP_ZERO the exponential is 0 (the call's underflow path is
+        // slow, and a narrow lobe seen away from its peak takes it nearly always).
+        let e = if x < EXP_ZERO { 0.0 } else { x.exp() };
         if e == 0.0 {
             // At extreme grazing both factors of D underflow: the limit is 0.
             return (0.0, 1.0, 1.0, f64::INFINITY);
@@ -322,6 +335,11 @@ impl Microfacet {
         BeckmannVisibleFrame::new(self.alpha, if w.z < 0.0 { -w } else { w })
     }
 }
+
+/// An argument below which `exp` is exactly 0 in double precision (it is
+/// from `-745.1332191019412` on: half the smallest subnormal, `e^-745.13`,
+/// rounds to 0), so that callers can skip the call.
+const EXP_ZERO: f64 = -746.0;
 
 /// Beckmann's exact Smith `Lambda` for `a = cot(theta) / alpha > 0`:
 /// `(erf(a) - 1) / 2 + exp(-a^2) / (2 a sqrt(pi))`.

@@ -119,6 +119,11 @@ pub struct MuGrid {
     pub w_graze: f64,
     /// Clustering scale at the critical angle.
     pub w_crit: f64,
+    /// The denominators `ln(1 + span / w)` of [`MuGrid::outside_coord`] and
+    /// [`MuGrid::inside_coord`] (outside, inside below `mu_c / 2`, from
+    /// `mu_c / 2` to `mu_c`, above `mu_c`), which depend on the grid alone:
+    /// computed once here, not at every lookup.
+    ln_span: [f64; 4],
 }
 
 #[inline]
@@ -129,12 +134,23 @@ fn geo(w: f64, span: f64, x: f64) -> f64 {
     w * ((1.0 + span / w).powf(x) - 1.0)
 }
 
+/// `ln(1 + span / w)`: the denominator of [`geo_inv`] (0 for an empty span, which [`geo_inv`] does not read).
 #[inline]
-fn geo_inv(w: f64, span: f64, d: f64) -> f64 {
+fn geo_ln_span(w: f64, span: f64) -> f64 {
     if span <= 0.0 {
         return 0.0;
     }
-    ((1.0 + d.clamp(0.0, span) / w).ln() / (1.0 + span / w).ln()).clamp(0.0, 1.0)
+    (1.0 + span / w).ln()
+}
+
+/// The inverse of [`geo`]: the node coordinate in `[0, 1]` of `d`, given
+/// `ln_span = `[`geo_ln_span`]`(w, span)`.
+#[inline]
+fn geo_inv(w: f64, span: f64, ln_span: f64, d: f64) -> f64 {
+    if span <= 0.0 {
+        return 0.0;
+    }
+    ((1.0 + d.clamp(0.0, span) / w).ln() / ln_span).clamp(0.0, 1.0)
 }
 
 impl MuGrid {
@@ -143,10 +159,19 @@ impl MuGrid {
         let mu_c = critical_mu(eta);
         let s_c = (1.0 - mu_c * mu_c).max(0.0).sqrt();
         let m = m.max(M_ALIGN);
+        let w_graze = (0.25 * m).max(W_MIN);
+        let w_crit = (0.25 * m * s_c).max(W_MIN);
+        let half = 0.5 * mu_c;
         MuGrid {
             mu_c,
-            w_graze: (0.25 * m).max(W_MIN),
-            w_crit: (0.25 * m * s_c).max(W_MIN),
+            w_graze,
+            w_crit,
+            ln_span: [
+                geo_ln_span(w_graze, 1.0),
+                geo_ln_span(w_graze, half),
+                geo_ln_span(w_crit, half),
+                geo_ln_span(w_crit, 1.0 - mu_c),
+            ],
         }
     }
     /// `mu` of node `k` of the outside tables.
@@ -156,7 +181,7 @@ impl MuGrid {
     /// Fractional node coordinate of `mu` on the outside grid.
     #[inline]
     pub fn outside_coord(&self, mu: f64) -> f64 {
-        geo_inv(self.w_graze, 1.0, mu) * (N_MU - 1) as f64
+        geo_inv(self.w_graze, 1.0, self.ln_span[0], mu) * (N_MU - 1) as f64
     }
     /// `mu` of node `k` of the inside tables.
     pub fn inside_mu(&self, k: usize) -> f64 {
@@ -176,11 +201,11 @@ impl MuGrid {
         let half = 0.5 * self.mu_c;
         let seg = SEG as f64;
         if mu >= self.mu_c {
-            2.0 * seg + seg * geo_inv(self.w_crit, 1.0 - self.mu_c, mu - self.mu_c)
+            2.0 * seg + seg * geo_inv(self.w_crit, 1.0 - self.mu_c, self.ln_span[3], mu - self.mu_c)
         } else if mu >= half {
-            seg + seg * (1.0 - geo_inv(self.w_crit, half, self.mu_c - mu))
+            seg + seg * (1.0 - geo_inv(self.w_crit, half, self.ln_span[2], self.mu_c - mu))
         } else {
-            seg * geo_inv(self.w_graze, half, mu)
+            seg * geo_inv(self.w_graze, half, self.ln_span[1], mu)
         }
     }
 }
@@ -230,7 +255,12 @@ fn outside_table(tab: &[f64; N_MU], grid: &MuGrid, mu: f64) -> f64 {
 
 #[inline]
 fn inside_table(tab: &[f64; N_MU], grid: &MuGrid, mu: f64) -> f64 {
-    let x = grid.inside_coord(mu.abs().min(1.0));
+    inside_at(tab, grid.inside_coord(mu.abs().min(1.0)))
+}
+
+/// [`inside_table`] at the node coordinate `x` of its `mu`.
+#[inline]
+fn inside_at(tab: &[f64; N_MU], x: f64) -> f64 {
     let seg = ((x as usize) / SEG).min(2);
     cubic_table(tab, x, seg * SEG, (seg + 1) * SEG).max(0.0)
 }
@@ -316,6 +346,23 @@ impl SurfaceIntegrals {
     #[inline]
     pub fn r_out(&self, mu: f64) -> f64 {
         outside_table(&self.r_out_nodes, &self.grid, mu)
+    }
+    /// `(Att(mu), r_out(mu))` at once: [`SurfaceIntegrals::att`] and
+    /// [`SurfaceIntegrals::r_out`] (the same values), locating `mu` on the grid once.
+    #[inline]
+    pub fn att_r_out(&self, mu: f64) -> (f64, f64) {
+        let x = self.grid.outside_coord(mu.abs().min(1.0));
+        (
+            cubic_table(&self.att_nodes, x, 0, N_MU - 1).max(0.0),
+            cubic_table(&self.r_out_nodes, x, 0, N_MU - 1).max(0.0),
+        )
+    }
+    /// `(r_in(mu), t_in(mu))` at once: [`SurfaceIntegrals::r_in`] and
+    /// [`SurfaceIntegrals::t_in`] (the same values), locating `mu` on the grid once.
+    #[inline]
+    pub fn r_t_in(&self, mu: f64) -> (f64, f64) {
+        let x = self.grid.inside_coord(mu.abs().min(1.0));
+        (inside_at(&self.r_in_nodes, x), inside_at(&self.t_in_nodes, x))
     }
     /// Directional reflectance (TIR included) for light from inside at cosine `mu` (magnitude).
     #[inline]

@@ -150,8 +150,9 @@ pub fn interpolate_nodes(eta: f64, m: f64, node: impl Fn(usize, usize) -> [f64; 
         let c = node_integrals(ci, cj, &node(ci, cj));
         let mu_c = c.grid.mu_c;
         for k in 0..N_MU {
-            s.att_nodes[k] += wk * c.att(out_mu[k]);
-            s.r_out_nodes[k] += wk * c.r_out(out_mu[k]);
+            let (att, r_out) = c.att_r_out(out_mu[k]);
+            s.att_nodes[k] += wk * att;
+            s.r_out_nodes[k] += wk * r_out;
             // Inside, the kink of total internal reflection moves with eta: the
             // corner is read at the same position relative to its own critical cosine.
             let mu = in_mu[k];
@@ -162,8 +163,9 @@ pub fn interpolate_nodes(eta: f64, m: f64, node: impl Fn(usize, usize) -> [f64; 
             } else {
                 1.0
             };
-            s.r_in_nodes[k] += wk * c.r_in(mu_corner);
-            s.t_in_nodes[k] += wk * c.t_in(mu_corner);
+            let (r_in, t_in) = c.r_t_in(mu_corner);
+            s.r_in_nodes[k] += wk * r_in;
+            s.t_in_nodes[k] += wk * t_in;
         }
         s.rho_in += wk * c.rho_in;
         s.tbar_in += wk * c.tbar_in;

@@ -3,7 +3,7 @@
 //! of [`super::build`], with the geometry (inside cosines, phase function)
 //! that `eval` and `pdf` share.
 
-use super::tables::{lerp_nodes, NP};
+use super::tables::{node_at, TabPos, NP};
 use super::{grazing, side, single, Component, ComponentSet, PaperBsdf, TAU_DROP};
 use crate::spectrum::Rgb;
 use glam::{DVec2, DVec3};
@@ -15,9 +15,9 @@ use std::f64::consts::PI;
 pub(super) struct Inside {
     pub(super) mu_i: f64,
     pub(super) mu_o: f64,
-    /// `sqrt(min(|wi.z|, 1))`, `sqrt(min(|wo.z|, 1))` outside: the coordinates of the face tables.
-    pub(super) si: f64,
-    pub(super) so: f64,
+    /// The places of `|wi.z|`, `|wo.z|` (outside) on the face tables.
+    pub(super) si: TabPos,
+    pub(super) so: TabPos,
     /// The phase function as `p_num / p_den` (`p_num = 0`, `p_den = 1` if not asked).
     pub(super) p_num: f64,
     pub(super) p_den: f64,
@@ -85,7 +85,7 @@ impl PaperBsdf {
     /// Inside cosines of `wi`, `wo` and (if `want_phase`) the phase function
     /// between the inside directions: what `eval` and `pdf` share.
     #[inline(always)]
-    pub(super) fn inside(&self, wi: DVec3, wo: DVec3, want_phase: bool, (si, so): (f64, f64)) -> Inside {
+    pub(super) fn inside(&self, wi: DVec3, wo: DVec3, want_phase: bool, (si, so): (TabPos, TabPos)) -> Inside {
         let (t_i, t_o, mu_i, mu_o) = self.inside_dirs(wi, wo);
         let (p_num, p_den) = if want_phase && self.phase.weight() > 0.0 {
             self.phase.ratio(t_i.dot(t_o).clamp(-1.0, 1.0))
@@ -129,13 +129,16 @@ impl PaperBsdf {
         let reflect = e == x;
         let (si, so) = match pre {
             Some(g) => (g.si, g.so),
-            None => (wi.z.abs().min(1.0).sqrt(), wo.z.abs().min(1.0).sqrt()),
+            None => (
+                TabPos::new(wi.z.abs().min(1.0).sqrt()),
+                TabPos::new(wo.z.abs().min(1.0).sqrt()),
+            ),
         };
         let mut out = Rgb::ZERO;
         if reflect && set.contains(Component::Surface) {
             let f = match surface {
                 Some(f) => f,
-                None => self.faces[e].reflection_with_sqrt(e.local(wi), e.local(wo), si, so),
+                None => self.faces[e].reflection_at(e.local(wi), e.local(wo), si, so),
             };
             out += Rgb::splat(f);
         }
@@ -143,15 +146,15 @@ impl PaperBsdf {
         let mut sub = Rgb::ZERO;
         if set.contains(Component::Multiple) {
             if self.opts.energy_bound {
-                let (we, wx) = (lerp_nodes(&self.w_tab[e], si), lerp_nodes(&self.w_tab[x], so));
+                let (we, wx) = (si.lerp(&self.w_tab[e]), so.lerp(&self.w_tab[x]));
                 let c = if reflect { self.ms_r[e] } else { self.ms_t };
                 sub += c * we * wx;
             } else {
                 let c = if reflect { self.c_r[e] } else { self.c_t[e] };
-                sub += c * (fe.att_with_sqrt(si) * fx.att_with_sqrt(so));
+                sub += c * (fe.att_at(si) * fx.att_at(so));
             }
         }
-        let att = fe.att_with_sqrt(si) * fx.att_with_sqrt(so);
+        let att = fe.att_at(si) * fx.att_at(so);
         if att <= 0.0 {
             return out + sub * self.kappa;
         }
@@ -201,7 +204,7 @@ impl PaperBsdf {
                 self.kernel.eval(DVec2::new(-wi.x, -wi.y), DVec2::new(wo.x, wo.y), 1.0)
             };
             if k > 0.0 {
-                let amp = fe.att_dir_with_sqrt(si) * fx.att_dir_with_sqrt(so) * k;
+                let amp = fe.att_dir_at(si) * fx.att_dir_at(so) * k;
                 if self.grey {
                     sub += Rgb::splat((-self.tau.0[0] / mu_min).exp() * amp);
                 } else {
@@ -247,10 +250,7 @@ impl PaperBsdf {
     /// only a choice of strategy weights: any positive values would be unbiased.)
     #[inline(always)]
     pub(super) fn lobe_probs(&self, wo: DVec3) -> LobeProbs {
-        let st = wo.z.abs().min(1.0).sqrt();
-        let xs = st * (NP - 1) as f64;
-        let i = (xs as usize).min(NP - 2);
-        let f = xs - i as f64;
+        let (i, f) = node_at::<NP>(wo.z.abs().min(1.0).sqrt());
         let tab = &self.pr_tab[side(wo)];
         let (a, b) = (&tab[i], &tab[i + 1]);
         LobeProbs(std::array::from_fn(|k| a.0[k] * (1.0 - f) + b.0[k] * f))
@@ -267,6 +267,10 @@ impl PaperBsdf {
     }
 
     /// The mixture density; `surface_pdf` is the face's reflection density if the caller has it.
+    ///
+    /// Always inlined: `sample` and `pdf` then share its side and face
+    /// lookups and tests with their own.
+    #[inline(always)]
     pub(super) fn pdf_with(
         &self,
         wi: DVec3,
@@ -299,7 +303,7 @@ impl PaperBsdf {
             let g = match pre {
                 Some(g) => *g,
                 // The table coordinates are not needed for densities.
-                None => self.inside(wi, wo, true, (0.0, 0.0)),
+                None => self.inside(wi, wo, true, (TabPos::ZERO, TabPos::ZERO)),
             };
             pdf += pr[Lobe::Single] * self.pdf_single(wi, &g);
         }

@@ -35,7 +35,7 @@
 //! The back face (`z = -d`) is the same kind of object seen with `z` flipped:
 //! [`Side::local`](super::Side::local) maps a direction on the back side to the face's frame.
 
-use super::tables::{hemispherical, hemispherical_of_table, lerp_mu, lerp_nodes, node_at, NA};
+use super::tables::{hemispherical, hemispherical_of_table, hemispherical_pair, lerp_mu, lerp_nodes, TabPos, NA};
 use crate::boundary::{critical_mu, SurfaceIntegrals};
 use crate::dielectric::{Interface, RoughDielectric};
 use crate::fresnel::fresnel_dielectric;
@@ -88,7 +88,14 @@ impl Interface4 {
             comp: false,
         };
         if fs == FaceScattering::Multiple && matches!(bd.interface, Interface::Rough(_)) {
-            let lbar_o = 1.0 - hemispherical(|mu| me.si.att(mu) + me.si.r_out(mu), 0.0);
+            let lbar_o = 1.0
+                - hemispherical(
+                    |mu| {
+                        let (att, r_out) = me.si.att_r_out(mu);
+                        att + r_out
+                    },
+                    0.0,
+                );
             let lbar_i = (1.0 - me.si.rho_in - me.si.tbar_in).max(0.0);
             let lost = crate::microsurface_tables::lost_energy(bd.dist, bd.eta, bd.m);
             let tot = lost.t_out2 + lost.r_out2;
@@ -118,54 +125,41 @@ impl Interface4 {
         me
     }
 
-    /// Walter's reflectance from outside (the closed-form lobe's albedo), or Fresnel.
-    fn r_walter(&self, mu: f64) -> f64 {
+    /// For light from outside at `mu`: `(T_w, R_w, L_o)`, Walter's
+    /// transmittance (the collimated part) and reflectance (the closed-form
+    /// lobe's albedo, or Fresnel) and the energy `L_o` his interface loses
+    /// (0 without the compensation), from one lookup of the tables.
+    #[inline]
+    fn outside(&self, mu: f64) -> (f64, f64, f64) {
         match self.kind {
-            Interface::IndexMatched => 0.0,
-            Interface::Smooth => fresnel_dielectric(mu, self.eta),
-            Interface::Rough(_) => self.si.r_out(mu),
+            Interface::IndexMatched => (1.0, 0.0, 0.0),
+            Interface::Smooth => {
+                let f = fresnel_dielectric(mu, self.eta);
+                (1.0 - f, f, 0.0)
+            }
+            Interface::Rough(_) => {
+                let (att, r_out) = self.si.att_r_out(mu);
+                let lost = if self.comp { (1.0 - att - r_out).max(0.0) } else { 0.0 };
+                (att, r_out, lost)
+            }
         }
     }
-    /// Walter's transmittance from outside (the collimated part).
-    fn t_walter(&self, mu: f64) -> f64 {
+    /// For light from inside at inner cosine `mu`: `(R_in, T_in)`, the
+    /// reflectance (TIR included) and transmittance, all orders.
+    #[inline]
+    fn inside(&self, mu: f64) -> (f64, f64) {
         match self.kind {
-            Interface::IndexMatched => 1.0,
-            Interface::Smooth => 1.0 - fresnel_dielectric(mu, self.eta),
-            Interface::Rough(_) => self.si.att(mu),
-        }
-    }
-    /// Energy lost by Walter's interface for light from outside at `mu`.
-    fn lost_out(&self, mu: f64) -> f64 {
-        if !self.comp {
-            return 0.0;
-        }
-        (1.0 - self.si.att(mu) - self.si.r_out(mu)).max(0.0)
-    }
-    /// Energy lost for light from inside at inner cosine `mu`.
-    fn lost_in(&self, mu: f64) -> f64 {
-        if !self.comp {
-            return 0.0;
-        }
-        (1.0 - self.si.r_in(mu) - self.si.t_in(mu)).max(0.0)
-    }
-    /// Transmittance from outside, all orders.
-    fn t_out(&self, mu: f64) -> f64 {
-        self.t_walter(mu) + self.k.0 * self.lost_out(mu)
-    }
-    /// Reflectance from inside at inner cosine `mu` (TIR included), all orders.
-    fn r_in(&self, mu: f64) -> f64 {
-        match self.kind {
-            Interface::IndexMatched => 0.0,
-            Interface::Smooth => fresnel_dielectric(-mu, self.eta),
-            Interface::Rough(_) => self.si.r_in(mu) + (1.0 - self.k.1) * self.lost_in(mu),
-        }
-    }
-    /// Transmittance from inside at inner cosine `mu`, all orders.
-    fn t_in(&self, mu: f64) -> f64 {
-        match self.kind {
-            Interface::IndexMatched => 1.0,
-            Interface::Smooth => 1.0 - fresnel_dielectric(-mu, self.eta),
-            Interface::Rough(_) => self.si.t_in(mu) + self.k.1 * self.lost_in(mu),
+            Interface::IndexMatched => (0.0, 1.0),
+            Interface::Smooth => {
+                let f = fresnel_dielectric(-mu, self.eta);
+                (f, 1.0 - f)
+            }
+            Interface::Rough(_) => {
+                let (r, t) = self.si.r_t_in(mu);
+                // The energy lost by Walter's interface from inside.
+                let lost = if self.comp { (1.0 - r - t).max(0.0) } else { 0.0 };
+                (r + (1.0 - self.k.1) * lost, t + self.k.1 * lost)
+            }
         }
     }
     /// `(rho_in, Tbar_in)` for diffuse light from inside, all orders.
@@ -304,22 +298,24 @@ impl Face {
         for k in 0..NA {
             let t = k as f64 / (NA - 1) as f64;
             let mu = t * t;
-            let lo = ifc.lost_out(mu);
+            let (t_w, r_w, lo) = ifc.outside(mu);
             comp_e[k] = lo;
-            let (t_r, t_w) = (ifc.t_out(mu), ifc.t_walter(mu));
-            let r_r = ifc.r_walter(mu) + (1.0 - ifc.k.0) * lo;
+            // Transmittance from outside, all orders.
+            let t_r = t_w + ifc.k.0 * lo;
+            let r_r = r_w + (1.0 - ifc.k.0) * lo;
             let (att, att_dir, r_coat) = match coating {
                 None => (t_r, t_w, 0.0),
                 Some(nu) => {
                     // Inside the coating at the smooth refraction of mu through eta.
                     let mu_c = refracted_cos(mu, eta).unwrap_or(0.0);
                     let fs_ = fresnel_dielectric(mu_c, nu);
-                    let denom = 1.0 - fs_ * ifc.r_in(mu_c);
+                    let (r_in, t_in) = ifc.inside(mu_c);
+                    let denom = 1.0 - fs_ * r_in;
                     if denom <= 0.0 {
                         (0.0, 0.0, t_r)
                     } else {
                         let g = (1.0 - fs_) / denom;
-                        (t_r * g, t_w * g, t_r * fs_ * ifc.t_in(mu_c) / denom)
+                        (t_r * g, t_w * g, t_r * fs_ * t_in / denom)
                     }
                 }
             };
@@ -352,19 +348,16 @@ impl Face {
                         return (1.0, 0.0);
                     };
                     let fs_ = fresnel_dielectric(mu_c, nu);
-                    let r = ifc.r_in(mu_c);
+                    let (r, t_in) = ifc.inside(mu_c);
                     let denom = 1.0 - fs_ * r;
                     if denom <= 0.0 {
                         return (1.0, 0.0);
                     }
-                    (
-                        fs_ + (1.0 - fs_) * (1.0 - fs_) * r / denom,
-                        (1.0 - fs_) * ifc.t_in(mu_c) / denom,
-                    )
+                    (fs_ + (1.0 - fs_) * (1.0 - fs_) * r / denom, (1.0 - fs_) * t_in / denom)
                 };
                 // Kinks: TIR at the smooth boundary and at the rough face's critical angle, seen from the base.
                 let mu_k = critical_mu(n / eta.min(n)).max(critical_mu(n));
-                (hemispherical(|m| one(m).0, mu_k), hemispherical(|m| one(m).1, mu_k))
+                hemispherical_pair(one, mu_k)
             }
         };
         f.rho_in = rho.clamp(0.0, 1.0);
@@ -401,25 +394,37 @@ impl Face {
     /// [`Face::att`] at `mu` given also `st = sqrt(min(|mu|, 1))`.
     #[inline]
     pub fn att_with_sqrt(&self, st: f64) -> f64 {
+        self.att_at(TabPos::new(st))
+    }
+
+    /// [`Face::att`] at the place `p` of `mu` on the tables.
+    #[inline(always)]
+    pub fn att_at(&self, p: TabPos) -> f64 {
         if !self.use_att {
             return 1.0;
         }
         if self.exact_smooth {
-            return 1.0 - fresnel_dielectric(st * st, self.bd.eta);
+            return 1.0 - fresnel_dielectric(p.st * p.st, self.bd.eta);
         }
-        lerp_nodes(&self.att_tab, st)
+        p.lerp(&self.att_tab)
     }
 
     /// The collimated part of [`Face::att`] (what direct transmission carries), given `st`.
     #[inline]
     pub fn att_dir_with_sqrt(&self, st: f64) -> f64 {
+        self.att_dir_at(TabPos::new(st))
+    }
+
+    /// [`Face::att_dir_with_sqrt`] at the place `p` of `mu` on the tables.
+    #[inline(always)]
+    pub fn att_dir_at(&self, p: TabPos) -> f64 {
         if !self.use_att {
             return 1.0;
         }
         if self.exact_smooth {
-            return 1.0 - fresnel_dielectric(st * st, self.bd.eta);
+            return 1.0 - fresnel_dielectric(p.st * p.st, self.bd.eta);
         }
-        lerp_nodes(&self.att_dir_tab, st)
+        p.lerp(&self.att_dir_tab)
     }
 
     /// Directional reflectance for light from outside at cosine `mu`, every
@@ -498,7 +503,7 @@ impl Face {
     /// given `c2` in `(0, 1]`, with the interface's `1 / eta^2` in place of a
     /// division. From `c2`, the square roots of `c` and of the refracted
     /// cosine are independent and run side by side rather than one after the other.
-    #[inline]
+    #[inline(always)]
     pub fn fresnel_outside_sq(&self, c2: f64) -> f64 {
         if self.bd.eta == 1.0 {
             return 0.0;
@@ -552,15 +557,16 @@ impl Face {
         self.iface_k
     }
 
-    /// The separable lobes' reflection `sum_j c_j E_j(mu_i) E_j(mu_o)`, given `st = sqrt(mu)` of both.
-    #[inline]
-    pub fn lobes_reflection(&self, si: f64, so: f64) -> f64 {
-        let node = |st: f64| {
-            let (i, f) = node_at::<NA>(st);
+    /// The separable lobes' reflection `sum_j c_j E_j(mu_i) E_j(mu_o)`, given
+    /// the places of both cosines on the tables.
+    #[inline(always)]
+    pub fn lobes_reflection(&self, pi: TabPos, po: TabPos) -> f64 {
+        let node = |p: TabPos| {
+            let (i, f) = (p.i, p.f);
             let (a, b) = (self.lobe_tab[i], self.lobe_tab[i + 1]);
             [a[0] * (1.0 - f) + b[0] * f, a[1] * (1.0 - f) + b[1] * f]
         };
-        let (a, b) = (node(si), node(so));
+        let (a, b) = (node(pi), node(po));
         a[0] * b[0] + a[1] * b[1]
     }
 
@@ -569,14 +575,19 @@ impl Face {
     /// separable lobes; zero for a face without microfacets (its reflection is a delta).
     #[inline]
     pub fn reflection(&self, wi: DVec3, wo: DVec3) -> f64 {
-        self.reflection_with_sqrt(wi, wo, wi.z.min(1.0).sqrt(), wo.z.min(1.0).sqrt())
+        self.reflection_at(
+            wi,
+            wo,
+            TabPos::new(wi.z.min(1.0).sqrt()),
+            TabPos::new(wo.z.min(1.0).sqrt()),
+        )
     }
 
-    /// [`Face::reflection`] given also `si = sqrt(min(wi.z, 1))` and
-    /// `so = sqrt(min(wo.z, 1))` (the separable lobes' table coordinates),
-    /// which the callers already have.
-    #[inline]
-    pub fn reflection_with_sqrt(&self, wi: DVec3, wo: DVec3, si: f64, so: f64) -> f64 {
+    /// [`Face::reflection`] given also the places `pi`, `po` of `wi.z` and
+    /// `wo.z` on the tables (the separable lobes' coordinates), which the
+    /// callers already have.
+    #[inline(always)]
+    pub fn reflection_at(&self, wi: DVec3, wo: DVec3, pi: TabPos, po: TabPos) -> f64 {
         let Interface::Rough(mf) = self.bd.interface else {
             return 0.0;
         };
@@ -586,13 +597,13 @@ impl Face {
         let lobes = if self.lobes.is_empty() {
             0.0
         } else {
-            self.lobes_reflection(si, so)
+            self.lobes_reflection(pi, po)
         };
         self.fresnel_outside_sq(oh2) * mf.reflection_dg_c2(c2, wi.z, wo.z) + lobes
     }
 
     /// Density of [`Face::sample_reflection`]: `pdf_visible(wo, h) / (4 |wo.h|)`.
-    #[inline]
+    #[inline(always)]
     pub fn reflection_pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
         let Some(mf) = self.microfacet() else { return 0.0 };
         let Some((c2, _)) = reflection_half(wi, wo) else {
@@ -603,9 +614,9 @@ impl Face {
 
     /// `(f_r, pdf)`: [`Face::reflection`] and [`Face::reflection_pdf`] at once,
     /// sharing `D(h)` and the masking of `wo` (for `sample`, which needs both);
-    /// `si`, `so` as in [`Face::reflection_with_sqrt`].
-    #[inline]
-    pub fn reflection_and_pdf(&self, wi: DVec3, wo: DVec3, si: f64, so: f64) -> (f64, f64) {
+    /// `pi`, `po` as in [`Face::reflection_at`].
+    #[inline(always)]
+    pub fn reflection_and_pdf(&self, wi: DVec3, wo: DVec3, pi: TabPos, po: TabPos) -> (f64, f64) {
         let Interface::Rough(mf) = self.bd.interface else {
             return (0.0, 0.0);
         };
@@ -616,7 +627,7 @@ impl Face {
         let lobes = if self.lobes.is_empty() {
             0.0
         } else {
-            self.lobes_reflection(si, so)
+            self.lobes_reflection(pi, po)
         };
         (self.fresnel_outside_sq(oh2) * dg + lobes, pdf)
     }

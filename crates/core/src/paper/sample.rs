@@ -3,6 +3,7 @@
 //! samples it (module doc of [`super`]).
 
 use super::eval::Lobe;
+use super::tables::TabPos;
 use super::{grazing, side, ComponentSet, PaperBsdf, Side};
 use crate::bsdf::{select_lobe, Bsdf, BsdfFlags, BsdfSample};
 use crate::geometry::sample_cosine_hemisphere;
@@ -83,7 +84,15 @@ impl Bsdf for PaperBsdf {
         if grazing(wi) || !wi.is_finite() {
             return None;
         }
-        let geo = self.inside(wi, wo, true, (wi.z.abs().min(1.0).sqrt(), wo.z.abs().min(1.0).sqrt()));
+        let geo = self.inside(
+            wi,
+            wo,
+            true,
+            (
+                TabPos::new(wi.z.abs().min(1.0).sqrt()),
+                TabPos::new(wo.z.abs().min(1.0).sqrt()),
+            ),
+        );
         // Reflection on a rough face: its value and density share the half vector.
         let (surf_f, surf_pdf) = if wi.z * wo.z > 0.0 && self.faces[x].microfacet().is_some() {
             let (f, p) = self.faces[x].reflection_and_pdf(x.local(wi), x.local(wo), geo.si, geo.so);

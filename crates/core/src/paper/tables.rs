@@ -32,8 +32,45 @@ where
 #[inline(always)]
 pub(crate) fn node_at<const N: usize>(st: f64) -> (usize, f64) {
     let x = st * (N - 1) as f64;
-    let i = (x as usize).min(N - 2);
+    // `(x as i32).max(0) as usize` is `x as usize` for every `x` once capped
+    // at `N - 2` (NaN and negatives give 0, large values the cap), in fewer
+    // instructions: x86-64 converts to signed integers only.
+    let i = ((x as i32).max(0) as usize).min(N - 2);
     (i, x - i as f64)
+}
+
+/// A cosine's place on the [`NA`]-node tables: `st = sqrt(min(|mu|, 1))` with
+/// the interval and fraction of [`node_at`], found once per direction and
+/// shared by every table read there ([`TabPos::lerp`] is [`lerp_nodes`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TabPos {
+    /// `sqrt(min(|mu|, 1))`.
+    pub st: f64,
+    /// The interval: nodes `i` and `i + 1`.
+    pub i: usize,
+    /// The fraction of the way from node `i` to node `i + 1`.
+    pub f: f64,
+}
+
+impl TabPos {
+    /// The place of grazing (`st = 0`), for callers that read no table.
+    pub const ZERO: TabPos = TabPos { st: 0.0, i: 0, f: 0.0 };
+
+    /// The place of `st = sqrt(min(|mu|, 1))`.
+    #[inline(always)]
+    pub fn new(st: f64) -> Self {
+        let (i, f) = node_at::<NA>(st);
+        TabPos { st, i, f }
+    }
+
+    /// [`lerp_nodes`] of `tab` at this place.
+    #[inline(always)]
+    pub fn lerp<T>(&self, tab: &[T; NA]) -> T
+    where
+        T: Copy + Mul<f64, Output = T> + Add<Output = T>,
+    {
+        tab[self.i] * (1.0 - self.f) + tab[self.i + 1] * self.f
+    }
 }
 
 /// Linear interpolation of a node table (of numbers or colours) at
@@ -70,10 +107,17 @@ pub(crate) fn hemispherical_of_table(tab: &[f64; NA]) -> f64 {
 /// on `[0, t_c]` and `[t_c, 1]` (a kink of total internal reflection at
 /// `mu = t_c^2` falls on the split).
 pub(crate) fn hemispherical(g: impl Fn(f64) -> f64, mu_split: f64) -> f64 {
+    hemispherical_pair(|mu| (g(mu), 0.0), mu_split).0
+}
+
+/// [`hemispherical`] of the two functions `g` returns, on the same points
+/// (each sum as [`hemispherical`] would form it): for pairs of integrands
+/// that share their work.
+pub(crate) fn hemispherical_pair(g: impl Fn(f64) -> (f64, f64), mu_split: f64) -> (f64, f64) {
     static GL: std::sync::OnceLock<(Vec<f64>, Vec<f64>)> = std::sync::OnceLock::new();
     let (x, w) = GL.get_or_init(|| gauss_legendre_01(24));
     let tc = mu_split.clamp(0.0, 1.0).sqrt();
-    let mut s = 0.0;
+    let (mut s0, mut s1) = (0.0, 0.0);
     for (lo, hi) in [(0.0, tc), (tc, 1.0)] {
         let len = hi - lo;
         if len <= 0.0 {
@@ -81,8 +125,10 @@ pub(crate) fn hemispherical(g: impl Fn(f64) -> f64, mu_split: f64) -> f64 {
         }
         for (xi, wi) in x.iter().zip(w) {
             let t = lo + len * xi;
-            s += wi * len * 4.0 * t * t * t * g(t * t);
+            let (a, b) = g(t * t);
+            s0 += wi * len * 4.0 * t * t * t * a;
+            s1 += wi * len * 4.0 * t * t * t * b;
         }
     }
-    s
+    (s0, s1)
 }
