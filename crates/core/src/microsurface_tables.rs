@@ -219,6 +219,37 @@ pub fn node(dist: Distribution, i: usize, j: usize) -> HemisphericalEstimate {
     e
 }
 
+/// The shares `(k_o, k_i)` of the energy-conserving face's compensation that
+/// go to transmission, for light from outside and from inside: `k_o` is the
+/// walk's own share `t_out2 / (t_out2 + r_out2)` of [`lost_energy`], and `k_i`
+/// follows from reciprocity, `k_o Lbar_o = eta^2 k_i Lbar_i`, where `lbar_o`,
+/// `lbar_i` are the hemispherical energies the single-scattering face loses
+/// from outside and inside. Where that would need `k_i > 1` (the walk's share
+/// is not reachable with separable lobes), `k_i = 1` and `k_o` is lowered to
+/// keep reciprocity; with nothing lost inside (`lbar_i <= 1e-12`) both are 0.
+/// Used by the Paper BSDF's faces and the adding-doubling faces of
+/// `paperbsdf-slab`, so both compensate alike.
+pub fn compensation_shares(dist: Distribution, eta: f64, m: f64, lbar_o: f64, lbar_i: f64) -> (f64, f64) {
+    let lost = lost_energy(dist, eta, m);
+    let tot = lost.t_out2 + lost.r_out2;
+    let k_o = if tot > 0.0 {
+        (lost.t_out2 / tot).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let e2 = eta * eta;
+    if lbar_i > 1e-12 {
+        let k_i = k_o * lbar_o.max(0.0) / (e2 * lbar_i);
+        if k_i > 1.0 {
+            (e2 * lbar_i / lbar_o, 1.0)
+        } else {
+            (k_o, k_i)
+        }
+    } else {
+        (0.0, 0.0)
+    }
+}
+
 /// The orders >= 2 fractions of the face (dist, eta, m), bilinear in the
 /// coordinates of [`crate::boundary::tables`] (`sqrt((eta - 1) / 4)`,
 /// `sqrt(m / (pi / 2))`). `eta` in [1, 5], `m` in [0, pi/2] (validate with

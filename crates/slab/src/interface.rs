@@ -105,7 +105,7 @@ use nalgebra::DMatrix;
 use paperbsdf_core::boundary::{dir_at_mu, directional_albedo_n};
 use paperbsdf_core::dielectric::Interface;
 use paperbsdf_core::fresnel::fresnel_dielectric;
-use paperbsdf_core::microsurface_tables::lost_energy;
+use paperbsdf_core::microsurface_tables::compensation_shares;
 use paperbsdf_core::quadrature::gauss_legendre_01;
 use paperbsdf_core::{DVec3, FaceScattering, RoughDielectric, TransportMode};
 use rayon::prelude::*;
@@ -476,26 +476,12 @@ fn compensate(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut Layer
         .collect();
     let lbar = |g: &Grid, lv: &[f64]| 2.0 * (0..g.len()).map(|j| g.w[j] * g.mu[j] * lv[j]).sum::<f64>();
     let (lbar_o, lbar_i) = (lbar(outside, &lost_out), lbar(inside, &lost_in));
-    // The shares as core defines them (paperbsdf_core::paper::face, step 2).
-    let lost_tab = lost_energy(bd.dist, bd.eta, bd.m);
-    let tot = lost_tab.t_out2 + lost_tab.r_out2;
-    let mut k_o = if tot > 0.0 {
-        (lost_tab.t_out2 / tot).clamp(0.0, 1.0)
+    // The shares as core defines them (the Paper BSDF's faces use the same function);
+    // a face that loses nothing from outside gets no compensation.
+    let (k_o, k_i) = if lbar_o > 0.0 {
+        compensation_shares(bd.dist, bd.eta, bd.m, lbar_o, lbar_i)
     } else {
-        0.0
-    };
-    let e2 = bd.eta * bd.eta;
-    let k_i = if lbar_i > 1e-12 && lbar_o > 0.0 {
-        let k_i = k_o * lbar_o / (e2 * lbar_i);
-        if k_i > 1.0 {
-            k_o = e2 * lbar_i / lbar_o;
-            1.0
-        } else {
-            k_i
-        }
-    } else {
-        k_o = 0.0;
-        0.0
+        (0.0, 0.0)
     };
     // order 0 of f = c E_a(mu_j) E_b(mu_o): K[o][j] = w_j mu_j 2 pi c E_a(mu_j) E_b(mu_o)
     let add = |k: &mut DMatrix<f64>, from: &Grid, ea: &[f64], to_e: &[f64], c: f64| {

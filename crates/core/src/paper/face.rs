@@ -97,28 +97,7 @@ impl Interface4 {
                     0.0,
                 );
             let lbar_i = (1.0 - me.si.rho_in - me.si.tbar_in).max(0.0);
-            let lost = crate::microsurface_tables::lost_energy(bd.dist, bd.eta, bd.m);
-            let tot = lost.t_out2 + lost.r_out2;
-            let mut k_o = if tot > 0.0 {
-                (lost.t_out2 / tot).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let e2 = bd.eta * bd.eta;
-            let k_i = if lbar_i > 1e-12 {
-                let k_i = k_o * lbar_o.max(0.0) / (e2 * lbar_i);
-                if k_i > 1.0 {
-                    // The walk's share is not reachable with these lobe shapes:
-                    // keep reciprocity and transmit all that is lost from inside.
-                    k_o = e2 * lbar_i / lbar_o;
-                    1.0
-                } else {
-                    k_i
-                }
-            } else {
-                k_o = 0.0;
-                0.0
-            };
+            let (k_o, k_i) = crate::microsurface_tables::compensation_shares(bd.dist, bd.eta, bd.m, lbar_o, lbar_i);
             me.k = (k_o, k_i);
             me.comp = true;
         }
