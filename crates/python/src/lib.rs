@@ -15,6 +15,7 @@
 
 use numpy::ndarray::{Array1, Array2, ArrayView2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use paperbsdf_core::models::ModelKind;
 use paperbsdf_core::paper::Component;
 use paperbsdf_core::{BsdfFlags, DVec3, PaperParams, Rgb};
 use paperbsdf_io::models::{load_model, load_model_text, LoadedModel};
@@ -345,6 +346,29 @@ impl Model {
     }
 }
 
+/// The names of the models built from parameters, from the one registry
+/// (`paperbsdf_core::models::ModelKind`, in its order; `measured` files are
+/// not a parameter model of this package).
+#[pyfunction]
+fn model_names() -> Vec<&'static str> {
+    ModelKind::ALL
+        .into_iter()
+        .filter(|&k| k != ModelKind::Measured)
+        .map(ModelKind::name)
+        .collect()
+}
+
+/// The names of the slab models, whose parameters are the Paper BSDF's (and
+/// the presets are such parameters): `ModelKind::is_slab`.
+#[pyfunction]
+fn slab_model_names() -> Vec<&'static str> {
+    ModelKind::ALL
+        .into_iter()
+        .filter(|k| k.is_slab())
+        .map(ModelKind::name)
+        .collect()
+}
+
 /// The names of the presets of `paperbsdf_core::presets`.
 #[pyfunction]
 fn preset_names() -> Vec<&'static str> {
@@ -528,6 +552,8 @@ fn flags_is_specular(flags: u8) -> bool {
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Model>()?;
+    m.add_function(wrap_pyfunction!(model_names, m)?)?;
+    m.add_function(wrap_pyfunction!(slab_model_names, m)?)?;
     m.add_function(wrap_pyfunction!(preset_names, m)?)?;
     m.add_function(wrap_pyfunction!(preset_json, m)?)?;
     m.add_function(wrap_pyfunction!(params_json, m)?)?;

@@ -48,7 +48,7 @@ __all__ = [
 #: Model names (docs/design.md 4.7): ``paper`` and ``reduced-multilayer`` take the
 #: Paper BSDF's parameters, ``lambert-glass`` takes ``k_d, k_t, eta, m, dist``,
 #: ``rough-dielectric`` takes ``eta, m, dist``.
-MODEL_NAMES = ("paper", "reduced-multilayer", "lambert-glass", "rough-dielectric")
+MODEL_NAMES = tuple(_native.model_names())  # from the Rust registry (ModelKind)
 
 #: Bits of the lobe flags (``Bsdf.flags``, and the flags ``sample_full`` returns).
 FLAG_REFLECTION = 1
@@ -57,7 +57,7 @@ FLAG_DIFFUSE = 4
 FLAG_GLOSSY = 8
 FLAG_SPECULAR = 16
 
-_PAPER_MODELS = ("paper", "reduced-multilayer")
+_PAPER_MODELS = tuple(_native.slab_model_names())
 
 
 def _params_text(params: Any, model: str, argname: str = "params") -> tuple[str, str, bool]:

@@ -194,7 +194,7 @@ def _make_class(mi, dr):
                 raise ValueError("paperbsdf plugin: give either `params` or `preset`, not both")
             if has_preset:
                 name = props["preset"]
-                if model not in ("paper", "reduced-multilayer"):
+                if model not in _pb._PAPER_MODELS:
                     raise ValueError(f"paperbsdf plugin: `preset` needs model paper or reduced-multilayer, not `{model}`")
                 params = _pb.preset(name)  # ValueError naming the preset and the known ones
             elif has_params:
