@@ -19,6 +19,8 @@
 //! with Radau outside; the nodes and weights are computed here, not copied.
 
 use nalgebra::{DMatrix, SymmetricEigen};
+use paperbsdf_core::boundary::critical_mu;
+use paperbsdf_core::fresnel::cos_transmitted;
 use paperbsdf_core::quadrature::gauss_legendre_01;
 
 /// Quadrature nodes and weights on one hemisphere, `mu` in `(0, 1]`, and the
@@ -68,23 +70,18 @@ impl Grid {
             return outside.clone();
         }
         let e2 = eta * eta;
-        let mu_c = (1.0 - 1.0 / e2).sqrt();
+        let mu_c = critical_mu(eta);
         let (x, wx) = gauss_legendre_01(n_tir);
         let mut mu: Vec<f64> = x.iter().map(|x| x * mu_c).collect();
         let mut w: Vec<f64> = wx.iter().map(|w| w * mu_c).collect();
         for (mo, wo) in outside.mu.iter().zip(&outside.w) {
-            let mi = snell_inside(*mo, eta);
+            // Outside to inside (eta > 1) never meets total internal reflection.
+            let mi = cos_transmitted(*mo, eta).map_or(0.0, f64::abs);
             mu.push(mi);
             w.push(wo * mo / (e2 * mi));
         }
         Grid { mu, w, eta }
     }
-}
-
-/// The cosine inside a medium of relative index `eta` of the refraction of an
-/// outside direction at cosine `mu_out`.
-pub fn snell_inside(mu_out: f64, eta: f64) -> f64 {
-    (1.0 - (1.0 - mu_out * mu_out) / (eta * eta)).sqrt()
 }
 
 /// `n`-point Gauss-Radau rule on `[0, 1]` with the fixed node at 1: (nodes
