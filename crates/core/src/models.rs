@@ -63,16 +63,21 @@ pub enum ModelKind {
     /// `measured`: a measured RGL `.bsdf` file; its "parameters" are the file
     /// (read by `paperbsdf_io`, not by this crate).
     Measured,
+    /// `slab`: the sheet of `paper` (same [`PaperParams`](crate::PaperParams))
+    /// solved numerically by adding-doubling; built by `paperbsdf_slab`
+    /// (`SlabBsdf`), not by this crate, which has no linear algebra.
+    Slab,
 }
 
 impl ModelKind {
     /// Every model, in the order of the listings.
-    pub const ALL: [ModelKind; 5] = [
+    pub const ALL: [ModelKind; 6] = [
         ModelKind::Paper,
         ModelKind::ReducedMultilayer,
         ModelKind::LambertGlass,
         ModelKind::RoughDielectric,
         ModelKind::Measured,
+        ModelKind::Slab,
     ];
 
     /// The name in files and on the command line.
@@ -83,13 +88,14 @@ impl ModelKind {
             ModelKind::LambertGlass => "lambert-glass",
             ModelKind::RoughDielectric => "rough-dielectric",
             ModelKind::Measured => "measured",
+            ModelKind::Slab => "slab",
         }
     }
 
     /// Whether the model is a slab whose parameters are [`PaperParams`](crate::PaperParams)
-    /// (`paper`, `reduced-multilayer`; the paper presets are such parameters).
+    /// (`paper`, `reduced-multilayer`, `slab`; the paper presets are such parameters).
     pub fn is_slab(self) -> bool {
-        matches!(self, ModelKind::Paper | ModelKind::ReducedMultilayer)
+        matches!(self, ModelKind::Paper | ModelKind::ReducedMultilayer | ModelKind::Slab)
     }
 
     /// Whether the fitter can fit the model (`paper`, `reduced-multilayer`, `lambert-glass`).
@@ -119,6 +125,12 @@ impl ModelKind {
             (ModelKind::ReducedMultilayer, ModelParams::Slab(p)) => Ok(Box::new(PaperBsdf::reduced_multilayer(p)?)),
             (ModelKind::LambertGlass, ModelParams::LambertGlass(p)) => Ok(Box::new(LambertGlass::new(p)?)),
             (ModelKind::RoughDielectric, ModelParams::RoughDielectric(p)) => Ok(Box::new(p.build()?)),
+            (ModelKind::Slab, _) => Err(ParamError::Invalid {
+                name: "model".to_string(),
+                message: "the model `slab` is built by paperbsdf_slab::SlabBsdf (or paperbsdf_io::models), \
+                          not by paperbsdf-core, which has no linear algebra"
+                    .to_string(),
+            }),
             (k, p) => Err(ParamError::Invalid {
                 name: "model".to_string(),
                 message: format!("model `{}` does not take {} parameters", k.name(), p.kind_name()),
@@ -487,7 +499,7 @@ impl ComponentModel for LambertGlass {
 mod tests {
     use super::*;
 
-    /// Every name parses back to its model, unknown names list all five, and
+    /// Every name parses back to its model, unknown names list all six, and
     /// each model is built from its own parameter type only.
     #[test]
     fn registry_round_trips_and_builds() {
@@ -497,7 +509,7 @@ mod tests {
         let e = "Paper".parse::<ModelKind>().unwrap_err().to_string();
         assert_eq!(
             e,
-            "unknown model `Paper`; known models: paper, reduced-multilayer, lambert-glass, rough-dielectric, measured"
+            "unknown model `Paper`; known models: paper, reduced-multilayer, lambert-glass, rough-dielectric, measured, slab"
         );
         assert_eq!(
             ModelKind::list(ModelKind::fittable()),
@@ -521,5 +533,8 @@ mod tests {
             "{e}"
         );
         assert!(ModelKind::Measured.build(&slab).is_err());
+        let e = ModelKind::Slab.build(&slab).err().unwrap().to_string();
+        assert!(e.contains("paperbsdf_slab::SlabBsdf"), "{e}");
+        assert!(ModelKind::Slab.is_slab() && !ModelKind::Slab.is_fittable());
     }
 }

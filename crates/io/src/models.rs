@@ -1,6 +1,7 @@
 //! Models by name, built from a parameter source: the registry that the CLI,
 //! the fitter and the renderer share. Names (docs/design.md 4.7): `paper`,
-//! `reduced-multilayer` (same parameters as `paper`), `lambert-glass`,
+//! `reduced-multilayer` and `slab` (same parameters as `paper`; `slab` is the
+//! same sheet solved by adding-doubling, `paperbsdf_slab`), `lambert-glass`,
 //! `rough-dielectric`; and `measured`, whose "parameters" are a measured
 //! RGL `.bsdf` file ([`crate::rgl`]).
 
@@ -33,6 +34,8 @@ pub enum LoadedModel {
     RoughDielectric(RoughDielectric),
     /// `measured`: an RGL `.bsdf` file.
     Measured(Box<crate::MeasuredBsdf>),
+    /// `slab`: the sheet solved by adding-doubling.
+    Slab(Box<paperbsdf_slab::SlabBsdf>),
 }
 
 /// Loads model `name` with parameters from `source` (file path, inline JSON, a
@@ -105,6 +108,18 @@ pub fn load_model_text(name: &str, text: &str, origin: &str, is_toml: bool) -> R
                 p.build()
             })?)
         }
+        ModelKind::Slab => {
+            let l = loaded::<PaperParams>(text, origin, is_toml)?;
+            LoadedModel::Slab(Box::new(paperbsdf_slab::SlabBsdf::new(&l.value).map_err(
+                |e| match e {
+                    paperbsdf_slab::SlabError::Param(p) => l.param_error(p),
+                    other => DataError::Other {
+                        file: origin.to_string(),
+                        message: other.to_string(),
+                    },
+                },
+            )?))
+        }
         ModelKind::Measured => {
             return Err(DataError::Other {
                 file: origin.to_string(),
@@ -122,6 +137,7 @@ impl LoadedModel {
             LoadedModel::LambertGlass(m) => m.as_ref(),
             LoadedModel::RoughDielectric(m) => m,
             LoadedModel::Measured(m) => m.as_ref(),
+            LoadedModel::Slab(m) => m.as_ref(),
         }
     }
 
@@ -143,6 +159,7 @@ impl LoadedModel {
                     LoadedModel::LambertGlass(_) => "the model lambert-glass",
                     LoadedModel::RoughDielectric(_) => "the model rough-dielectric",
                     LoadedModel::Measured(_) => "the measured BSDF",
+                    LoadedModel::Slab(_) => "the model slab",
                 },
                 has: has.iter().map(|c| c.name()).collect::<Vec<_>>().join(", "),
             }),

@@ -188,7 +188,9 @@ pub fn default_start_thickness(grid: &Grid) -> f64 {
 /// The medium layer of order `m`: single-scattering albedo `albedo` in
 /// `[0, 1]`, optical thickness `tau` in `[0, inf)`, phase coefficients
 /// `phase` on `grid`; started at a thickness of at most `start` (module doc)
-/// and doubled to `tau`. Returns the layer and the number of doublings.
+/// and doubled to `tau` (for `albedo = 0` the layer is the closed form: no
+/// reflection, transmission `exp(-tau / mu)`). Returns the layer and the
+/// number of doublings.
 pub fn medium_layer(
     grid: &Grid,
     phase: &PhaseFourier,
@@ -219,6 +221,21 @@ pub fn medium_layer(
             SymmetricLayer {
                 r: DMatrix::zeros(n, n),
                 t: DMatrix::identity(n, n),
+            },
+            0,
+        ));
+    }
+    if albedo == 0.0 {
+        // No scattering: no reflection, and each direction is attenuated by
+        // exp(-tau / mu) (the limit the doubling converges to, here exact).
+        let t = DMatrix::from_diagonal(&nalgebra::DVector::from_iterator(
+            n,
+            grid.mu.iter().map(|&mu| (-tau / mu).exp()),
+        ));
+        return Ok((
+            SymmetricLayer {
+                r: DMatrix::zeros(n, n),
+                t,
             },
             0,
         ));

@@ -43,6 +43,7 @@
 //! mostly the faces' projection and normalisation); the 2% accuracy of the
 //! BSDF values themselves (only totals are checked against the simulator).
 
+pub mod bsdf;
 pub mod error;
 pub mod interface;
 pub mod layer;
@@ -50,8 +51,9 @@ pub mod phase;
 pub mod quad;
 pub mod slab;
 
+pub use bsdf::{SlabBsdf, SlabOptions};
 pub use error::SlabError;
 pub use interface::{face_interface, Compensation, ProjectedFace, Projection};
 pub use layer::{Layer, SymmetricLayer};
 pub use quad::Grid;
-pub use slab::{Discretisation, Face, Medium, Side, SlabSpec, Solution};
+pub use slab::{Discretisation, Face, Medium, Prepared, Side, SlabSpec, Solution};

@@ -5,7 +5,7 @@
 use crate::error::SlabError;
 use crate::interface::{face_interface, Compensation, ProjectedFace, Projection, DEFAULT_AZIMUTH_POINTS};
 use crate::layer::{default_start_thickness, medium_layer, Layer};
-use crate::phase::{phase_fourier, validate};
+use crate::phase::{phase_fourier, validate, PhaseFourier};
 use crate::quad::Grid;
 use paperbsdf_core::dielectric::{ETA_RANGE, M_RANGE};
 use paperbsdf_core::phase::TwoLobeHg;
@@ -209,6 +209,15 @@ impl SlabSpec {
 
     /// Solves the sheet with discretisation `disc`: Fourier orders in parallel.
     pub fn solve(&self, disc: &Discretisation) -> Result<Solution, SlabError> {
+        self.prepare(disc)?.solve(self.medium.albedo, self.medium.tau)
+    }
+
+    /// Everything of a solve that does not depend on the medium's albedo and
+    /// optical thickness: the grids, the phase function's Fourier
+    /// coefficients and the faces projected on the grids (the costly part of
+    /// a solve with rough faces). [`Prepared::solve`] then solves the sheet
+    /// for any albedo and thickness (one call per colour channel).
+    pub fn prepare(&self, disc: &Discretisation) -> Result<Prepared, SlabError> {
         self.validate()?;
         if disc.nodes < 2 {
             return Err(SlabError::Discretisation {
@@ -243,10 +252,45 @@ impl SlabSpec {
         } else {
             project(&self.back, "_b")?
         };
-        let solved: Vec<(Layer, Layer, u32)> = (0..disc.orders)
+        Ok(Prepared {
+            outside,
+            inside,
+            phase,
+            start,
+            orders: disc.orders,
+            faces: [front, back],
+        })
+    }
+}
+
+/// The medium-independent part of a solve ([`SlabSpec::prepare`]).
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    /// The grid in air on either side of the sheet.
+    pub outside: Grid,
+    /// The grid inside the medium.
+    pub inside: Grid,
+    /// The phase function's Fourier coefficients on the inside grid.
+    pub phase: PhaseFourier,
+    /// Thickness of the starting layer before doubling.
+    pub start: f64,
+    /// Fourier orders `0..orders`.
+    pub orders: usize,
+    /// The front and back faces projected on the grids (air on top, medium
+    /// below: the back face's layer is used flipped).
+    pub faces: [ProjectedFace; 2],
+}
+
+impl Prepared {
+    /// Solves the sheet for a medium of single-scattering albedo `albedo` in
+    /// `[0, 1]` and optical thickness `tau` (the grids, phase function and
+    /// faces of [`SlabSpec::prepare`]): Fourier orders in parallel.
+    pub fn solve(&self, albedo: f64, tau: f64) -> Result<Solution, SlabError> {
+        let [front, back] = &self.faces;
+        let solved: Vec<(Layer, Layer, u32)> = (0..self.orders)
             .into_par_iter()
             .map(|m| {
-                let (med, k) = medium_layer(&inside, &phase, m, self.medium.albedo, self.medium.tau, start)?;
+                let (med, k) = medium_layer(&self.inside, &self.phase, m, albedo, tau, self.start)?;
                 let med = med.into_layer();
                 let sheet = front.orders[m].add(&med)?.add(&back.orders[m].flipped())?;
                 Ok((sheet, med, k))
@@ -255,13 +299,13 @@ impl SlabSpec {
         let doublings = solved.first().map_or(0, |s| s.2);
         let (orders, medium): (Vec<Layer>, Vec<Layer>) = solved.into_iter().map(|(a, b, _)| (a, b)).unzip();
         Ok(Solution {
-            outside,
-            inside,
+            outside: self.outside.clone(),
+            inside: self.inside.clone(),
             orders,
             medium,
             doublings,
-            phase_scale: phase.scale,
-            face_compensation: [front.compensation, back.compensation],
+            phase_scale: self.phase.scale.clone(),
+            face_compensation: [front.compensation.clone(), back.compensation.clone()],
         })
     }
 }

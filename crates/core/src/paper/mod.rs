@@ -503,6 +503,43 @@ impl PaperBsdf {
         self.faces[face].r_out(mu)
     }
 
+    /// The surface reflection of the face on `side` (every non-delta lobe of
+    /// the face: Walter's and the separable compensation lobes), `f_r(wi, wo)`
+    /// without cosine, both directions in the sheet frame on that side
+    /// (zero otherwise, and for a face without microfacets).
+    pub fn face_reflection(&self, side: Side, wi: DVec3, wo: DVec3) -> f64 {
+        if side.local(wi).z <= 0.0 || side.local(wo).z <= 0.0 {
+            return 0.0;
+        }
+        self.faces[side].reflection(side.local(wi), side.local(wo))
+    }
+
+    /// Draws a reflected `wi` (sheet frame) from the visible normals of the
+    /// face on the side of `wo` (Walter's lobe only; `None` for a face
+    /// without microfacets or a draw below the face), density [`PaperBsdf::face_reflection_pdf`].
+    pub fn sample_face_reflection(&self, wo: DVec3, u: [f64; 2]) -> Option<DVec3> {
+        let side = Side::of(wo);
+        self.faces[side]
+            .sample_reflection(side.local(wo), u)
+            .map(|wi| side.local(wi))
+    }
+
+    /// Density (solid angle) of [`PaperBsdf::sample_face_reflection`]; zero
+    /// when `wi` and `wo` are on different sides.
+    pub fn face_reflection_pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        if wi.z * wo.z <= 0.0 {
+            return 0.0;
+        }
+        let side = Side::of(wo);
+        self.faces[side].reflection_pdf(side.local(wi), side.local(wo))
+    }
+
+    /// Whether the face on `side` has no microfacets (smooth or index-matched:
+    /// its reflection is a delta lobe of reflectance [`PaperBsdf::face_reflectance`]).
+    pub fn face_is_smooth(&self, side: Side) -> bool {
+        self.faces[side].microfacet().is_none()
+    }
+
     /// Albedo of the single-scattering term (reflection plus transmission) per
     /// unit flux *entering* through `face` at outside cosine `mu` (tabulated).
     pub fn single_scattering_albedo(&self, face: Side, mu: f64) -> Rgb {

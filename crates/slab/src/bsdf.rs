@@ -1,0 +1,657 @@
+//! The model `slab`: the sheet of the Paper BSDF (same parameters, same
+//! faces) solved by adding-doubling ([`crate::slab`]), as a BSDF with
+//! `eval`, `sample` and `pdf` at arbitrary directions (issue 13).
+//!
+//! **The split into sharp and smooth parts.** What the grid cannot resolve is
+//! kept analytic:
+//! - the lit face's reflection ([`Component::Surface`]): core's face
+//!   ([`PaperBsdf::face_reflection`]: Walter et al. 2007 plus, for
+//!   `face_scattering = "multiple"`, its separable compensation lobe), or the
+//!   Fresnel delta of a smooth face. Its projection on the grid
+//!   ([`crate::interface`]) is what the adding-doubling solution holds for
+//!   that face's first reflection, and it is subtracted from every Fourier
+//!   order, so nothing is counted twice;
+//! - for two smooth faces, the unscattered light: mirror-like internal
+//!   reflections and straight-through transmission are delta lobes, in
+//!   closed form (`T = (1-F)^2 a / (1 - F^2 a^2)`, internal reflection
+//!   `F (1-F)^2 a^2 / (1 - F^2 a^2)`, `a = exp(-tau / mu_t)` with `mu_t` the
+//!   refracted cosine, `F` Fresnel's unpolarised reflectance); the solution
+//!   with the medium's albedo set to 0 holds exactly these (diagonal
+//!   matrices), and it is subtracted.
+//!
+//! Everything else (light that entered the sheet: scattered once or more,
+//! and the unscattered light through a rough face) is the **table**: per side
+//! of incidence, reflection or transmission, outgoing node `o`, incident node
+//! `j` and Fourier order `m`, the coefficient
+//! `c_m[o][j] = (2 - [m = 0]) K_m[o][j] / (2 pi w_j mu_j)` of the solution's
+//! matrices ([`crate::Solution::bsdf_at_nodes`]), so that at the nodes
+//! `f = sum_m c_m cos(m phi)` with `phi` the azimuth difference of the
+//! propagation directions (`cos phi = -(wi_xy . wo_xy) / (|wi_xy| |wo_xy|)`:
+//! `phi = 0` is forward scattering, the mirror direction in reflection and
+//! the straight-through direction in transmission).
+//!
+//! **Between the nodes** `f` is interpolated linearly in `mu_i` and in `mu_o`
+//! (bilinear in the node pair of each cosine; constant below the smallest
+//! node, `mu = 1` is a node): linear weights are symmetric in the two
+//! cosines, so the interpolated table keeps the solution's reciprocity
+//! exactly, and they never overshoot. The Fourier sum can ring below zero
+//! for lobes narrower than the orders resolve: `eval` returns `max(f, 0)`
+//! per channel.
+//!
+//! **Sampling.** A mixture of (a) the lit face's visible-normal sampling
+//! (core's), (b) its delta lobes, and (c) the table: for each node of `wo`, a
+//! piecewise-constant density over cells of `(hemisphere, mu_i, |phi|)`
+//! (bins in `mu` between the midpoints of the nodes, `phi_bins` uniform bins
+//! in `[0, pi]`, either sign of `phi` with probability 1/2) whose cell
+//! weights are `f |cos| dmu dphi` at the cell centre, with `wi`'s density
+//! taken from `f(wo -> wi)` by reciprocity; `wo` off the nodes mixes the two
+//! neighbouring nodes' densities with the interpolation weights. A share
+//! [`COSINE_SHARE`] of the table's draws is cosine-weighted over both
+//! hemispheres, so the density is positive wherever `f` is. Lobes are chosen
+//! in proportion to their albedos at `wo`. `pdf` is the mixture's exact
+//! density (checked by a chi-square test, tests/slab_bsdf.rs).
+//!
+//! **Components.** [`Component::Surface`] (analytic), [`Component::Direct`]
+//! (light that left without scattering in the medium, the lit face's first
+//! reflection excluded: internal reflections and transmission through rough
+//! faces, from the albedo-0 solution; delta lobes are not in `eval`) and
+//! [`Component::Multiple`], which here is **every scattering order**, single
+//! scattering included (`slab` does not split orders 1 and 2+).
+
+use crate::error::SlabError;
+use crate::slab::{Discretisation, SlabSpec, Solution};
+use nalgebra::DMatrix;
+use paperbsdf_core::bsdf::{Bsdf, BsdfFlags, BsdfSample};
+use paperbsdf_core::fresnel::{cos_transmitted, fresnel_dielectric};
+use paperbsdf_core::geometry::sample_cosine_hemisphere;
+use paperbsdf_core::models::{Component, ComponentModel};
+use paperbsdf_core::paper::Side;
+use paperbsdf_core::{DVec3, PaperBsdf, PaperParams, Rgb};
+use std::f64::consts::PI;
+
+/// Share of the table's draws that are cosine-weighted over both hemispheres
+/// (module doc): keeps the density positive where the table's cells are empty.
+pub const COSINE_SHARE: f64 = 0.1;
+
+/// Most Fourier orders a [`SlabBsdf`] evaluates (the size of `eval`'s cosine buffer).
+pub const MAX_ORDERS: usize = 128;
+
+/// How finely a [`SlabBsdf`] is solved and tabulated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlabOptions {
+    /// Gauss-Radau nodes per hemisphere outside ([`Discretisation::nodes`]).
+    pub nodes: usize,
+    /// Nodes in the cone of total internal reflection ([`Discretisation::tir_nodes`]).
+    pub tir_nodes: usize,
+    /// Fourier orders in azimuth, 1 to [`MAX_ORDERS`].
+    pub orders: usize,
+    /// Bins in `|phi|` of the sampling density, 1 to 1024.
+    pub phi_bins: usize,
+}
+
+impl Default for SlabOptions {
+    fn default() -> Self {
+        SlabOptions {
+            nodes: 32,
+            tir_nodes: 16,
+            orders: 32,
+            phi_bins: 32,
+        }
+    }
+}
+
+/// Delta lobes of the unscattered light through two smooth faces (module doc).
+#[derive(Clone, Copy, Debug)]
+struct SmoothSheet {
+    eta: f64,
+    tau: Rgb,
+}
+
+impl SmoothSheet {
+    /// `(R, T)` of the delta lobes at outside cosine `mu` (R includes the first
+    /// surface's Fresnel reflection).
+    fn delta(&self, mu: f64) -> (Rgb, Rgb) {
+        let f = fresnel_dielectric(mu, self.eta);
+        let Some(mu_t) = cos_transmitted(mu, self.eta) else {
+            return (Rgb::splat(f), Rgb::ZERO);
+        };
+        let mu_t = mu_t.abs();
+        let a = self.tau.map(|t| (-t / mu_t).exp());
+        let t = a.map(|a| (1.0 - f) * (1.0 - f) * a / (1.0 - f * f * a * a));
+        let r = a.map(|a| f + f * (1.0 - f) * (1.0 - f) * a * a / (1.0 - f * f * a * a));
+        (r, t)
+    }
+}
+
+/// The sampling density of the table for one node of `wo` (module doc).
+#[derive(Clone, Debug)]
+struct CellDensity {
+    /// Cumulative cell probabilities (ascending, last 1), cells ordered
+    /// `(h, k, b)` with `h` 0 same side, 1 other side.
+    cdf: Vec<f64>,
+    /// The cells' probabilities.
+    prob: Vec<f64>,
+}
+
+/// The `slab` model (module doc).
+#[derive(Clone, Debug)]
+pub struct SlabBsdf {
+    /// The Paper BSDF of the same parameters: its faces give the analytic surface reflection.
+    paper: PaperBsdf,
+    /// Outside nodes, ascending, `mu[n - 1] = 1`.
+    mu: Vec<f64>,
+    /// Fourier orders.
+    orders: usize,
+    /// `[side of incidence][transmit]`: coefficients `c_m[o][j]` at `(o n + j) M + m`.
+    table: [[Vec<Rgb>; 2]; 2],
+    /// The same for the unscattered part of the table (component `direct`).
+    direct: [[Vec<Rgb>; 2]; 2],
+    /// Delta lobes of two smooth faces.
+    smooth: Option<SmoothSheet>,
+    /// Bin edges in `mu` of the sampling cells: 0, the nodes' midpoints, 1.
+    edges: Vec<f64>,
+    phi_bins: usize,
+    /// `[side of wo][node]`: the table's sampling density.
+    cells: [Vec<CellDensity>; 2],
+    /// `[side of wo][node]`: the table's albedo (channel mean) at the node.
+    table_albedo: [Vec<f64>; 2],
+    is_rgb: bool,
+    flags: BsdfFlags,
+}
+
+/// The place of `mu` among ascending `nodes`: `(i, t)` with `f = (1 - t) f_i + t f_{i+1}`.
+#[inline]
+fn locate(nodes: &[f64], mu: f64) -> (usize, f64) {
+    let n = nodes.len();
+    if mu <= nodes[0] {
+        return (0, 0.0);
+    }
+    if mu >= nodes[n - 1] {
+        return (n - 2, 1.0);
+    }
+    let i = nodes.partition_point(|&x| x <= mu) - 1;
+    (i, (mu - nodes[i]) / (nodes[i + 1] - nodes[i]))
+}
+
+/// `cos phi` of the propagation directions' azimuth difference (module doc);
+/// when `wo` is normal its azimuth reference is `+x`, when both are, 1.
+#[inline]
+fn cos_phi(wi: DVec3, wo: DVec3) -> f64 {
+    let si = (wi.x * wi.x + wi.y * wi.y).sqrt();
+    let so = (wo.x * wo.x + wo.y * wo.y).sqrt();
+    if si < 1e-12 {
+        return 1.0;
+    }
+    let c = if so < 1e-12 {
+        -wi.x / si
+    } else {
+        -(wi.x * wo.x + wi.y * wo.y) / (si * so)
+    };
+    c.clamp(-1.0, 1.0)
+}
+
+impl SlabBsdf {
+    /// Solves the sheet of `p` with the default [`SlabOptions`].
+    pub fn new(p: &PaperParams) -> Result<SlabBsdf, SlabError> {
+        SlabBsdf::with_options(p, &SlabOptions::default())
+    }
+
+    /// Solves the sheet of `p` with `opts`: the faces are projected once, each
+    /// distinct colour channel is solved (with its medium and with the
+    /// medium's albedo set to 0), the tables and sampling densities are built.
+    pub fn with_options(p: &PaperParams, opts: &SlabOptions) -> Result<SlabBsdf, SlabError> {
+        if opts.orders == 0 || opts.orders > MAX_ORDERS {
+            return Err(SlabError::Discretisation {
+                name: "orders",
+                value: opts.orders as f64,
+                range: "[1, 128]",
+            });
+        }
+        if opts.phi_bins == 0 || opts.phi_bins > 1024 {
+            return Err(SlabError::Discretisation {
+                name: "phi_bins",
+                value: opts.phi_bins as f64,
+                range: "[1, 1024]",
+            });
+        }
+        let paper = PaperBsdf::new(p)?;
+        let specs = [
+            SlabSpec::from_params(p, 0)?,
+            SlabSpec::from_params(p, 1)?,
+            SlabSpec::from_params(p, 2)?,
+        ];
+        let disc = Discretisation {
+            nodes: opts.nodes,
+            tir_nodes: opts.tir_nodes,
+            orders: opts.orders,
+            ..Discretisation::default()
+        };
+        let prepared = specs[0].prepare(&disc)?;
+        let both_smooth = paper.face_is_smooth(Side::Front) && paper.face_is_smooth(Side::Back);
+        // Solve each distinct channel: (full, unscattered).
+        let mut solved: Vec<(usize, Solution, Solution)> = Vec::new();
+        for (c, spec) in specs.iter().enumerate() {
+            if let Some(k) = (0..c).find(|&k| specs[k].medium == spec.medium) {
+                let s = solved.iter().find(|s| s.0 == k).expect("solved earlier");
+                let (a, b) = (s.1.clone(), s.2.clone());
+                solved.push((c, a, b));
+                continue;
+            }
+            let full = prepared.solve(spec.medium.albedo, spec.medium.tau)?;
+            let unscattered = prepared.solve(0.0, spec.medium.tau)?;
+            solved.push((c, full, unscattered));
+        }
+        let g = &prepared.outside;
+        let n = g.len();
+        let m_count = opts.orders;
+        // The faces' first reflection from outside, per order: the front
+        // face's r_top, the back face's (used flipped) r_top.
+        let face_r = |side: usize, m: usize| -> &DMatrix<f64> { &prepared.faces[side].orders[m].r_top };
+        fn block(sol: &Solution, side: usize, transmit: bool, m: usize) -> &DMatrix<f64> {
+            let l = &sol.orders[m];
+            match (side, transmit) {
+                (0, false) => &l.r_top,
+                (0, true) => &l.t_down,
+                (_, false) => &l.r_bot,
+                (_, true) => &l.t_up,
+            }
+        }
+        let mut table: [[Vec<Rgb>; 2]; 2] = Default::default();
+        let mut direct: [[Vec<Rgb>; 2]; 2] = Default::default();
+        for side in 0..2 {
+            for (t, transmit) in [false, true].into_iter().enumerate() {
+                let mut tab = vec![Rgb::ZERO; n * n * m_count];
+                let mut dir = vec![Rgb::ZERO; n * n * m_count];
+                for (c, full, unsc) in &solved {
+                    for m in 0..m_count {
+                        let eps = if m == 0 { 1.0 } else { 2.0 };
+                        let (kf, ku) = (block(full, side, transmit, m), block(unsc, side, transmit, m));
+                        for o in 0..n {
+                            for j in 0..n {
+                                let scale = eps / (2.0 * PI * g.w[j] * g.mu[j]);
+                                let surface = if transmit { 0.0 } else { face_r(side, m)[(o, j)] };
+                                let (vt, vd) = if both_smooth {
+                                    (kf[(o, j)] - ku[(o, j)], 0.0)
+                                } else {
+                                    (kf[(o, j)] - surface, ku[(o, j)] - surface)
+                                };
+                                // At normal incidence or exit (the node mu = 1)
+                                // nothing depends on azimuth: orders m >= 1
+                                // vanish (the projection leaves rounding there).
+                                let (vt, vd) = if m > 0 && (o == n - 1 || j == n - 1) {
+                                    (0.0, 0.0)
+                                } else {
+                                    (vt, vd)
+                                };
+                                let idx = (o * n + j) * m_count + m;
+                                tab[idx].0[*c] = vt * scale;
+                                dir[idx].0[*c] = vd * scale;
+                            }
+                        }
+                    }
+                }
+                table[side][t] = tab;
+                direct[side][t] = dir;
+            }
+        }
+        let smooth = both_smooth.then(|| SmoothSheet {
+            eta: specs[0].front.eta(),
+            tau: Rgb([specs[0].medium.tau, specs[1].medium.tau, specs[2].medium.tau]),
+        });
+        let mut edges = Vec::with_capacity(n + 1);
+        edges.push(0.0);
+        for k in 0..n - 1 {
+            edges.push(0.5 * (g.mu[k] + g.mu[k + 1]));
+        }
+        edges.push(1.0);
+        let front_smooth = paper.face_is_smooth(Side::Front);
+        let back_smooth = paper.face_is_smooth(Side::Back);
+        let mut flags = BsdfFlags::REFLECTION | BsdfFlags::TRANSMISSION | BsdfFlags::DIFFUSE;
+        if !(front_smooth && back_smooth) {
+            flags |= BsdfFlags::GLOSSY;
+        }
+        if front_smooth || back_smooth {
+            flags |= BsdfFlags::SPECULAR;
+        }
+        let mut me = SlabBsdf {
+            paper,
+            mu: g.mu.clone(),
+            orders: m_count,
+            table,
+            direct,
+            smooth,
+            edges,
+            phi_bins: opts.phi_bins,
+            cells: [Vec::new(), Vec::new()],
+            table_albedo: [Vec::new(), Vec::new()],
+            is_rgb: p.is_rgb(),
+            flags,
+        };
+        for side in Side::BOTH {
+            let (cells, albedo): (Vec<CellDensity>, Vec<f64>) = (0..n).map(|j| me.cell_density(side, me.mu[j])).unzip();
+            me.cells[side as usize] = cells;
+            me.table_albedo[side as usize] = albedo;
+        }
+        Ok(me)
+    }
+
+    /// The sampling density of the table for `wo` at cosine `mu_o` on `side`,
+    /// and the table's albedo there (channel mean).
+    fn cell_density(&self, side: Side, mu_o: f64) -> (CellDensity, f64) {
+        let n = self.mu.len();
+        let pb = self.phi_bins;
+        let dphi = PI / pb as f64;
+        let so = (1.0 - mu_o * mu_o).max(0.0).sqrt();
+        let wo = DVec3::new(so, 0.0, side.sign() * mu_o);
+        let mut prob = Vec::with_capacity(2 * n * pb);
+        for h in 0..2 {
+            let z_sign = if h == 0 { side.sign() } else { -side.sign() };
+            for k in 0..n {
+                let (e0, e1) = (self.edges[k], self.edges[k + 1]);
+                let mu = 0.5 * (e0 + e1);
+                let s = (1.0 - mu * mu).max(0.0).sqrt();
+                for b in 0..pb {
+                    let phi = (b as f64 + 0.5) * dphi;
+                    // wi toward the light: propagation azimuth differs by phi
+                    // from wo's, so wi's azimuth is pi + phi (module doc).
+                    let wi = DVec3::new(-s * phi.cos(), -s * phi.sin(), z_sign * mu);
+                    let f = self.eval_table(&self.table, wo, wi).mean().max(0.0);
+                    prob.push(f * mu * (e1 - e0) * dphi * 2.0);
+                }
+            }
+        }
+        let total: f64 = prob.iter().sum();
+        let mut cdf = Vec::with_capacity(prob.len());
+        let mut acc = 0.0;
+        if total > 0.0 {
+            for p in prob.iter_mut() {
+                *p /= total;
+                acc += *p;
+                cdf.push(acc);
+            }
+        } else {
+            cdf.resize(prob.len(), 0.0);
+        }
+        (CellDensity { cdf, prob }, total)
+    }
+
+    /// The table `tab` at `(wi, wo)` (module doc), before clamping.
+    #[inline]
+    fn eval_table(&self, tab: &[[Vec<Rgb>; 2]; 2], wi: DVec3, wo: DVec3) -> Rgb {
+        let side = Side::of(wi);
+        let transmit = wi.z * wo.z < 0.0;
+        let t = &tab[side as usize][transmit as usize];
+        let n = self.mu.len();
+        let mcount = self.orders;
+        let (j, tj) = locate(&self.mu, wi.z.abs());
+        let (o, to) = locate(&self.mu, wo.z.abs());
+        let c = cos_phi(wi, wo);
+        let mut cos_m = [0.0f64; MAX_ORDERS];
+        cos_m[0] = 1.0;
+        if mcount > 1 {
+            cos_m[1] = c;
+            for m in 2..mcount {
+                cos_m[m] = 2.0 * c * cos_m[m - 1] - cos_m[m - 2];
+            }
+        }
+        let corner = |oo: usize, jj: usize| -> Rgb {
+            let base = (oo * n + jj) * mcount;
+            let mut acc = [0.0f64; 3];
+            for (cm, cosv) in t[base..base + mcount].iter().zip(&cos_m[..mcount]) {
+                acc[0] += cm.0[0] * cosv;
+                acc[1] += cm.0[1] * cosv;
+                acc[2] += cm.0[2] * cosv;
+            }
+            Rgb(acc)
+        };
+        let mut f = Rgb::ZERO;
+        for (oo, wo_) in [(o, 1.0 - to), (o + 1, to)] {
+            if wo_ == 0.0 {
+                continue;
+            }
+            for (jj, wj) in [(j, 1.0 - tj), (j + 1, tj)] {
+                if wj == 0.0 {
+                    continue;
+                }
+                f += corner(oo, jj) * (wo_ * wj);
+            }
+        }
+        f
+    }
+
+    /// The solved outside nodes (ascending, the last `mu = 1`).
+    pub fn nodes(&self) -> &[f64] {
+        &self.mu
+    }
+
+    /// Memory held by the tables and sampling densities, in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        let tables: usize = self
+            .table
+            .iter()
+            .chain(self.direct.iter())
+            .flat_map(|s| s.iter())
+            .map(|v| v.len() * std::mem::size_of::<Rgb>())
+            .sum();
+        let cells: usize = self
+            .cells
+            .iter()
+            .flat_map(|s| s.iter())
+            .map(|c| (c.cdf.len() + c.prob.len()) * 8)
+            .sum();
+        tables + cells
+    }
+
+    /// The lobe probabilities at `wo`: (surface lobe, delta lobes, table).
+    fn lobe_weights(&self, wo: DVec3) -> (f64, Rgb, Rgb, f64) {
+        let side = Side::of(wo);
+        let mu = wo.z.abs().min(1.0);
+        let (r_delta, t_delta) = match &self.smooth {
+            Some(s) => s.delta(mu),
+            None if self.paper.face_is_smooth(side) => (Rgb::splat(self.paper.face_reflectance(side, mu)), Rgb::ZERO),
+            None => (Rgb::ZERO, Rgb::ZERO),
+        };
+        let surface = if self.paper.face_is_smooth(side) {
+            0.0
+        } else {
+            self.paper.face_reflectance(side, mu)
+        };
+        let (j, t) = locate(&self.mu, mu);
+        let alb = &self.table_albedo[side as usize];
+        let table = alb[j] * (1.0 - t) + alb[j + 1] * t;
+        (surface, r_delta, t_delta, table)
+    }
+
+    /// Probabilities of (surface, delta R, delta T, table) at `wo`, summing to 1 (or all 0).
+    fn lobe_probs(&self, wo: DVec3) -> [f64; 4] {
+        let (s, rd, td, tab) = self.lobe_weights(wo);
+        let w = [s, rd.mean(), td.mean(), tab];
+        let total: f64 = w.iter().sum();
+        if total > 0.0 {
+            w.map(|x| x / total)
+        } else {
+            [0.0; 4]
+        }
+    }
+
+    /// The table's density of `wi` for `wo` (no lobe probability): the
+    /// interpolated cell densities, mixed with the cosine share.
+    fn table_pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        let side = Side::of(wo);
+        let (j, t) = locate(&self.mu, wo.z.abs());
+        let h = usize::from(wi.z * wo.z <= 0.0);
+        let k = (self.edges.partition_point(|&e| e <= wi.z.abs()).max(1) - 1).min(self.mu.len() - 1);
+        let dphi = PI / self.phi_bins as f64;
+        let phi = cos_phi(wi, wo).acos();
+        let b = ((phi / dphi) as usize).min(self.phi_bins - 1);
+        let cell = (h * self.mu.len() + k) * self.phi_bins + b;
+        let area = 2.0 * (self.edges[k + 1] - self.edges[k]) * dphi;
+        let cells = &self.cells[side as usize];
+        let p_tab = (cells[j].prob[cell] * (1.0 - t) + cells[j + 1].prob[cell] * t) / area;
+        (1.0 - COSINE_SHARE) * p_tab + COSINE_SHARE * wi.z.abs() / (2.0 * PI)
+    }
+
+    /// Draws `wi` from the table's density for `wo` (`uc` uniform, `u` for the cell).
+    fn sample_table(&self, wo: DVec3, uc: f64, u: [f64; 2]) -> Option<DVec3> {
+        let side = Side::of(wo);
+        if uc < COSINE_SHARE {
+            let v = uc / COSINE_SHARE;
+            let d = sample_cosine_hemisphere(u);
+            let z = if v < 0.5 { side.sign() } else { -side.sign() };
+            return Some(DVec3::new(d.x, d.y, z * d.z));
+        }
+        let mut v = (uc - COSINE_SHARE) / (1.0 - COSINE_SHARE);
+        let (j, t) = locate(&self.mu, wo.z.abs());
+        let node = if v < 1.0 - t {
+            v /= 1.0 - t;
+            j
+        } else {
+            v = (v - (1.0 - t)) / t;
+            j + 1
+        };
+        let cd = &self.cells[side as usize][node];
+        let cell = cd.cdf.partition_point(|&c| c <= v).min(cd.cdf.len() - 1);
+        if cd.prob[cell] <= 0.0 {
+            return None;
+        }
+        let lo = if cell == 0 { 0.0 } else { cd.cdf[cell - 1] };
+        let sign = if (v - lo) / cd.prob[cell] < 0.5 { 1.0 } else { -1.0 };
+        let pb = self.phi_bins;
+        let n = self.mu.len();
+        let (h, rest) = (cell / (n * pb), cell % (n * pb));
+        let (k, b) = (rest / pb, rest % pb);
+        let mu = self.edges[k] + u[0] * (self.edges[k + 1] - self.edges[k]);
+        let phi = sign * (b as f64 + u[1]) * PI / pb as f64;
+        let s = (1.0 - mu * mu).max(0.0).sqrt();
+        // wo's azimuth (reference +x at normal), then pi + phi from it.
+        let so = (wo.x * wo.x + wo.y * wo.y).sqrt();
+        let (co, sn) = if so < 1e-12 { (1.0, 0.0) } else { (wo.x / so, wo.y / so) };
+        let (cp, sp) = (-phi.cos(), -phi.sin());
+        let (x, y) = (co * cp - sn * sp, sn * cp + co * sp);
+        let z = if h == 0 { side.sign() } else { -side.sign() };
+        Some(DVec3::new(s * x, s * y, z * mu))
+    }
+
+    /// The continuous part of `f` (the table, clamped at 0, plus the analytic surface reflection).
+    fn eval_all(&self, wi: DVec3, wo: DVec3) -> Rgb {
+        let table = self.eval_table(&self.table, wi, wo).map(|x| x.max(0.0));
+        if wi.z * wo.z > 0.0 {
+            table + Rgb::splat(self.paper.face_reflection(Side::of(wi), wi, wo))
+        } else {
+            table
+        }
+    }
+}
+
+impl Bsdf for SlabBsdf {
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
+        if wi.z == 0.0 || wo.z == 0.0 {
+            return Rgb::ZERO;
+        }
+        self.eval_all(wi, wo)
+    }
+
+    fn sample(&self, wo: DVec3, uc: f64, u: [f64; 2]) -> Option<BsdfSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let probs = self.lobe_probs(wo);
+        let (lobe, start) = paperbsdf_core::bsdf::select_lobe(uc, &probs)?;
+        let v = ((uc - start) / probs[lobe]).clamp(0.0, 1.0 - 1e-16);
+        let mu = wo.z.abs();
+        let (_, rd, td, _) = self.lobe_weights(wo);
+        let wi = match lobe {
+            1 => {
+                let wi = DVec3::new(-wo.x, -wo.y, wo.z);
+                return Some(BsdfSample {
+                    wi,
+                    f: rd / mu,
+                    pdf: probs[1],
+                    flags: BsdfFlags::REFLECTION | BsdfFlags::SPECULAR,
+                });
+            }
+            2 => {
+                return Some(BsdfSample {
+                    wi: -wo,
+                    f: td / mu,
+                    pdf: probs[2],
+                    flags: BsdfFlags::TRANSMISSION | BsdfFlags::SPECULAR,
+                });
+            }
+            0 => self.paper.sample_face_reflection(wo, u)?,
+            _ => self.sample_table(wo, v, u)?,
+        };
+        if wi.z == 0.0 {
+            return None;
+        }
+        let pdf = self.pdf(wi, wo);
+        if pdf <= 0.0 {
+            return None;
+        }
+        let flags = if wi.z * wo.z > 0.0 {
+            BsdfFlags::REFLECTION
+                | if lobe == 0 {
+                    BsdfFlags::GLOSSY
+                } else {
+                    BsdfFlags::DIFFUSE
+                }
+        } else {
+            BsdfFlags::TRANSMISSION | BsdfFlags::DIFFUSE
+        };
+        Some(BsdfSample {
+            wi,
+            f: self.eval_all(wi, wo),
+            pdf,
+            flags,
+        })
+    }
+
+    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        if wi.z == 0.0 || wo.z == 0.0 {
+            return 0.0;
+        }
+        let probs = self.lobe_probs(wo);
+        let mut p = 0.0;
+        if probs[0] > 0.0 {
+            p += probs[0] * self.paper.face_reflection_pdf(wi, wo);
+        }
+        if probs[3] > 0.0 {
+            p += probs[3] * self.table_pdf(wi, wo);
+        }
+        p
+    }
+
+    fn flags(&self) -> BsdfFlags {
+        self.flags
+    }
+}
+
+impl ComponentModel for SlabBsdf {
+    fn eval_component(&self, wi: DVec3, wo: DVec3, c: Component) -> Rgb {
+        if wi.z == 0.0 || wo.z == 0.0 {
+            return Rgb::ZERO;
+        }
+        match c {
+            Component::Surface => {
+                if wi.z * wo.z > 0.0 {
+                    Rgb::splat(self.paper.face_reflection(Side::of(wi), wi, wo))
+                } else {
+                    Rgb::ZERO
+                }
+            }
+            Component::Direct => self.eval_table(&self.direct, wi, wo).map(|x| x.max(0.0)),
+            Component::Multiple => {
+                (self.eval_table(&self.table, wi, wo) - self.eval_table(&self.direct, wi, wo)).map(|x| x.max(0.0))
+            }
+            Component::Single => Rgb::ZERO,
+        }
+    }
+
+    fn is_rgb(&self) -> bool {
+        self.is_rgb
+    }
+
+    fn components(&self) -> &'static [Component] {
+        &[Component::Surface, Component::Multiple, Component::Direct]
+    }
+}

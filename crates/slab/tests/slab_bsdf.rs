@@ -1,0 +1,339 @@
+//! The model `slab` as a BSDF (crates/slab/src/bsdf.rs): sampling against its
+//! density (chi-square, core's harness as pbrt-v4's and Mitsuba 3's), exact
+//! reciprocity of the interpolated tables for unequal faces, energy (albedo
+//! by integration over the outgoing argument with every component and the
+//! delta lobes included), agreement with the solution at the nodes, the
+//! closed-form delta lobes of smooth sheets, and bad input.
+//!
+//! Sheets: the matte and luster presets (luster: Beckmann 0.15 front, GGX
+//! 0.3 back), a thin tissue (optical thickness ~3), a weak scatterer, a
+//! sheet with smooth faces (delta lobes), an index-matched one, and a
+//! non-absorbing sheet with `face_scattering = "multiple"` (energy closes).
+
+#[path = "../../core/tests/support/chi2.rs"]
+mod chi2;
+
+use paperbsdf_core::bsdf::albedo_from;
+use paperbsdf_core::geometry::spherical_direction;
+use paperbsdf_core::models::{Component, ComponentModel};
+use paperbsdf_core::presets::preset;
+use paperbsdf_core::{Bsdf, Colour, DVec3, Distribution, FaceScattering, PaperParams};
+use paperbsdf_slab::{SlabBsdf, SlabOptions, SlabSpec};
+
+fn sheet(d: f64, sa: f64, ss: f64, faces: [(f64, f64, Distribution); 2], fs: FaceScattering) -> PaperParams {
+    PaperParams {
+        name: None,
+        d,
+        sigma_a: Colour::Scalar(sa),
+        sigma_s: Colour::Scalar(ss),
+        g_f: 0.8,
+        g_b: -0.4,
+        w_b: 0.2,
+        eta_f: faces[0].0,
+        m_f: faces[0].1,
+        dist_f: faces[0].2,
+        eta_b: faces[1].0,
+        m_b: faces[1].1,
+        dist_b: faces[1].2,
+        face_scattering: fs,
+    }
+}
+
+fn cases() -> Vec<(&'static str, PaperParams)> {
+    use Distribution::{Beckmann, Ggx};
+    let mut v = vec![
+        ("matte", preset("matte").unwrap()),
+        ("luster", preset("luster").unwrap()),
+        (
+            "thin-tissue",
+            sheet(
+                0.03,
+                0.5,
+                100.0,
+                [(1.5, 0.2, Ggx), (1.5, 0.35, Beckmann)],
+                FaceScattering::Multiple,
+            ),
+        ),
+        (
+            "weak-scatter",
+            sheet(
+                0.1,
+                2.0,
+                10.0,
+                [(1.5, 0.3, Ggx), (1.5, 0.3, Ggx)],
+                FaceScattering::Single,
+            ),
+        ),
+    ];
+    v.push((
+        "smooth",
+        sheet(
+            0.05,
+            1.0,
+            40.0,
+            [(1.5, 0.0, Ggx), (1.5, 0.0, Ggx)],
+            FaceScattering::Single,
+        ),
+    ));
+    v.push((
+        "index-matched",
+        sheet(
+            0.05,
+            1.0,
+            40.0,
+            [(1.0, 0.0, Ggx), (1.0, 0.0, Ggx)],
+            FaceScattering::Single,
+        ),
+    ));
+    v
+}
+
+fn dir(theta_deg: f64, phi: f64, side: f64) -> DVec3 {
+    let w = spherical_direction(theta_deg.to_radians(), phi);
+    DVec3::new(w.x, w.y, side * w.z)
+}
+
+#[test]
+fn sampling_matches_the_density() {
+    let mut failures = Vec::new();
+    let mut p_min = 1.0f64;
+    let mut n = 0;
+    for (name, p) in cases() {
+        let b = SlabBsdf::new(&p).unwrap();
+        for side in [1.0, -1.0] {
+            // 0.3 deg: between the two largest nodes; 47: off the nodes; 84: grazing.
+            for theta in [0.0, 0.3, 47.0, 84.0] {
+                let wo = dir(theta, 0.7, side);
+                let r = chi2::chi2_test(
+                    &format!("{name} theta_o={theta} side={side}"),
+                    |u| {
+                        b.sample(wo, u[0], [u[1], u[2]])
+                            .filter(|s| !s.flags.is_specular())
+                            .map(|s| s.wi)
+                    },
+                    |wi| b.pdf(wi, wo),
+                    40_000,
+                    7 + n as u64,
+                );
+                n += 1;
+                match r {
+                    Ok(pv) => p_min = p_min.min(pv),
+                    Err(e) => failures.push(e),
+                }
+            }
+        }
+    }
+    eprintln!("{n} chi-square tests, smallest p = {p_min:.3e}");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn sample_returns_eval_and_pdf() {
+    for (name, p) in cases() {
+        let b = SlabBsdf::new(&p).unwrap();
+        let wo = dir(38.0, 1.1, -1.0);
+        for i in 0..400 {
+            let u = [
+                (i as f64 + 0.5) / 400.0,
+                ((i * 7) % 400) as f64 / 400.0,
+                ((i * 13) % 397) as f64 / 397.0,
+            ];
+            let Some(s) = b.sample(wo, u[0], [u[1], u[2]]) else {
+                continue;
+            };
+            assert!((s.wi.length() - 1.0).abs() < 1e-9, "{name}: non-unit {:?}", s.wi);
+            if s.flags.is_specular() {
+                continue;
+            }
+            let (f, pdf) = (b.eval(s.wi, wo), b.pdf(s.wi, wo));
+            for c in 0..3 {
+                assert!(
+                    (s.f.0[c] - f.0[c]).abs() <= 1e-12 * f.0[c].abs().max(1e-300),
+                    "{name}: f {s:?} vs {f:?}"
+                );
+            }
+            assert!((s.pdf - pdf).abs() <= 1e-12 * pdf, "{name}: pdf {} vs {pdf}", s.pdf);
+        }
+    }
+}
+
+#[test]
+fn reciprocity_holds_for_unequal_faces() {
+    let mut worst = 0.0f64;
+    for (name, p) in cases() {
+        let b = SlabBsdf::new(&p).unwrap();
+        for a in [0.0, 3.0, 21.0, 55.0, 79.0, 88.0] {
+            for c in [1.0, 17.0, 40.0, 66.0, 87.0] {
+                for (sa, sc) in [(1.0, 1.0), (1.0, -1.0), (-1.0, -1.0)] {
+                    let (wi, wo) = (dir(a, 0.3, sa), dir(c, 2.2, sc));
+                    let (f, r) = (b.eval(wi, wo), b.eval(wo, wi));
+                    for k in 0..3 {
+                        let e = (f.0[k] - r.0[k]).abs() / f.0[k].abs().max(1e-6);
+                        worst = worst.max(e);
+                        assert!(e < 1e-9, "{name}: f({a},{c},{sa},{sc}) = {f:?}, reversed {r:?}");
+                    }
+                }
+            }
+        }
+    }
+    eprintln!("reciprocity: worst relative difference {worst:.2e}");
+}
+
+/// `albedo_from` integrates over the outgoing argument with every component
+/// and the delta lobes; 64 x 64 stratified samples.
+#[test]
+fn energy_is_bounded_and_closes_without_absorption() {
+    // No albedo above 1.
+    for (name, p) in cases() {
+        let b = SlabBsdf::new(&p).unwrap();
+        for side in [1.0, -1.0] {
+            for theta in [0.0, 30.0, 60.0, 80.0, 89.0] {
+                let (r, t) = albedo_from(&b, dir(theta, 0.2, side), 96);
+                let a = (r + t).max_channel();
+                assert!(a <= 1.0 + 3e-3, "{name}: albedo {a} at theta {theta} side {side}");
+            }
+        }
+    }
+    // A conservative sheet with energy-conserving faces closes: R + T = 1.
+    let p = sheet(
+        0.05,
+        0.0,
+        60.0,
+        [(1.5, 0.2, Distribution::Ggx), (1.5, 0.45, Distribution::Beckmann)],
+        FaceScattering::Multiple,
+    );
+    let b = SlabBsdf::new(&p).unwrap();
+    let mut worst = 0.0f64;
+    for side in [1.0, -1.0] {
+        for theta in [0.0, 25.0, 50.0, 70.0, 82.0] {
+            let (r, t) = albedo_from(&b, dir(theta, 0.2, side), 128);
+            let e = ((r + t).mean() - 1.0).abs();
+            worst = worst.max(e);
+            assert!(e < 5e-3, "R + T = {} at theta {theta} side {side}", (r + t).mean());
+        }
+    }
+    eprintln!("conservative sheet: |R + T - 1| <= {worst:.2e}");
+}
+
+/// At the nodes, in the plane of incidence, `eval` is the solution's BSDF
+/// with the projected first reflection replaced by core's face.
+#[test]
+fn eval_at_the_nodes_is_the_solution() {
+    let p = preset("luster").unwrap();
+    let opts = SlabOptions::default();
+    let b = SlabBsdf::with_options(&p, &opts).unwrap();
+    let spec = SlabSpec::from_params(&p, 0).unwrap();
+    let disc = paperbsdf_slab::Discretisation {
+        nodes: opts.nodes,
+        tir_nodes: opts.tir_nodes,
+        orders: opts.orders,
+        ..Default::default()
+    };
+    let sol = spec.solve(&disc).unwrap();
+    let mu = b.nodes().to_vec();
+    let n = mu.len();
+    for &j in &[3usize, 12, 20, n - 2] {
+        for &o in &[5usize, 17, 25] {
+            let (si, so) = ((1.0 - mu[j] * mu[j]).sqrt(), (1.0 - mu[o] * mu[o]).sqrt());
+            // Transmission, front: light from wi = (-si, 0, mu_j) propagating forward
+            // leaves at wo = (so cos phi, so sin phi, -mu_o).
+            for phi in [0.0f64, 1.3, 3.0] {
+                let wi = DVec3::new(-si, 0.0, mu[j]);
+                let wo = DVec3::new(so * phi.cos(), so * phi.sin(), -mu[o]);
+                let want = sol.bsdf_at_nodes(paperbsdf_slab::Side::Front, true, o, j, phi);
+                let got = b.eval(wi, wo).0[0];
+                assert!(
+                    (got - want).abs() <= 1e-9 * want.abs() + 1e-12,
+                    "T at nodes ({o}, {j}, {phi}): {got} vs {want}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn smooth_sheets_have_closed_form_delta_lobes() {
+    // Two smooth faces: the delta transmission of the unscattered light is
+    // (1-F)^2 a / (1 - F^2 a^2), a = exp(-tau / mu_t).
+    let p = sheet(
+        0.05,
+        1.0,
+        40.0,
+        [(1.5, 0.0, Distribution::Ggx), (1.5, 0.0, Distribution::Ggx)],
+        FaceScattering::Single,
+    );
+    let b = SlabBsdf::new(&p).unwrap();
+    let tau = 0.05 * 41.0;
+    for theta in [0.0f64, 40.0, 75.0] {
+        let wo = dir(theta, 0.0, 1.0);
+        let mu = wo.z;
+        let f = paperbsdf_core::fresnel::fresnel_dielectric(mu, 1.5);
+        let mu_t = paperbsdf_core::fresnel::cos_transmitted(mu, 1.5).unwrap().abs();
+        let a = (-tau / mu_t).exp();
+        let t_want = (1.0 - f) * (1.0 - f) * a / (1.0 - f * f * a * a);
+        let mut t_got = 0.0;
+        for i in 0..1000 {
+            let uc = (i as f64 + 0.5) / 1000.0;
+            if let Some(s) = b.sample(wo, uc, [0.3, 0.6]) {
+                if s.flags.is_specular() && s.wi.z < 0.0 {
+                    assert!((s.wi + wo).length() < 1e-12);
+                    t_got = s.f.0[0] * mu;
+                }
+            }
+        }
+        assert!(
+            (t_got - t_want).abs() < 1e-12,
+            "theta {theta}: delta T {t_got} vs {t_want}"
+        );
+    }
+}
+
+#[test]
+fn components_sum_to_eval() {
+    for (name, p) in cases() {
+        let b = SlabBsdf::new(&p).unwrap();
+        for (wi, wo) in [
+            (dir(20.0, 0.0, 1.0), dir(50.0, 2.0, 1.0)),
+            (dir(70.0, 0.0, -1.0), dir(10.0, 0.5, 1.0)),
+            (dir(5.0, 0.0, 1.0), dir(35.0, 3.0, -1.0)),
+        ] {
+            let total = b.eval(wi, wo);
+            let sum = b
+                .components()
+                .iter()
+                .fold(paperbsdf_core::Rgb::ZERO, |s, &c| s + b.eval_component(wi, wo, c));
+            for k in 0..3 {
+                assert!(
+                    (total.0[k] - sum.0[k]).abs() <= 1e-9 * total.0[k].abs().max(1e-9),
+                    "{name}: components {sum:?} vs eval {total:?}"
+                );
+            }
+        }
+        assert_eq!(
+            b.eval_component(dir(20.0, 0.0, 1.0), dir(20.0, 3.1, 1.0), Component::Single)
+                .0,
+            [0.0; 3]
+        );
+    }
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let p = preset("matte").unwrap();
+    let e = SlabBsdf::with_options(
+        &p,
+        &SlabOptions {
+            orders: 0,
+            ..Default::default()
+        },
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("orders"), "{e}");
+    let glossy = preset("glossy").unwrap();
+    let e = SlabBsdf::new(&glossy).unwrap_err();
+    assert!(e.to_string().contains("eta_f != eta_b"), "{e}");
+    let mut bad = p.clone();
+    bad.m_f = 2.0;
+    let e = SlabBsdf::new(&bad).unwrap_err();
+    assert!(e.to_string().contains("m_f"), "{e}");
+}
