@@ -304,6 +304,25 @@ impl Model {
         ))
     }
 
+    /// The Paper BSDF's construction-time state (its faces' node tables, the
+    /// multiple-scattering tables, the phase function, the lobe-selection
+    /// table, the direct kernel) as the text of its `Debug` representation,
+    /// for `paper` and `reduced-multilayer`; `None` for the other models.
+    ///
+    /// `paperbsdf.mitsuba_native` reads the tables from it to evaluate the
+    /// model in Dr.Jit. `paperbsdf_core::PaperBsdf` keeps these fields
+    /// private, and `Debug` is its one complete view of them from this crate;
+    /// Rust's `Debug` prints every `f64` in its shortest round-trip form, so
+    /// the values are exact. (A layout change in core makes the reader raise,
+    /// and the Python tests compare the Dr.Jit evaluation with this model's.)
+    #[getter]
+    fn paper_state(&self) -> Option<String> {
+        match &self.model {
+            LoadedModel::Paper(m) => Some(format!("{m:?}")),
+            _ => None,
+        }
+    }
+
     /// Directional albedo for light at polar angles `theta_i_deg` (degrees, in
     /// [0, 90]) in the x-z plane arriving at the `side` face (`front`: from
     /// z > 0, `back`: from z < 0); the routine of `paperbsdf albedo`. Returns
