@@ -92,11 +92,12 @@ class NativePaper:
 
     # --- plumbing ---------------------------------------------------------
     def _buffer(self, a: np.ndarray):
-        """A flat float32 table as a Dr.Jit array that `dr.gather` reads."""
-        flat = np.ascontiguousarray(np.asarray(a, dtype=np.float32).reshape(-1))
+        """A flat table as a Dr.Jit array that `dr.gather` reads (float32 in
+        JIT variants); in scalar variants a list of Python floats, the Rust
+        model's float64 values unrounded."""
         if self.jit:
-            return self.mi.Float(flat)
-        return [float(v) for v in flat]
+            return self.mi.Float(np.ascontiguousarray(np.asarray(a, dtype=np.float32).reshape(-1)))
+        return [float(v) for v in np.asarray(a, dtype=np.float64).reshape(-1)]
 
     def _not(self, m):
         """Logical not of a mask (a Python bool in scalar variants, where `~` is not)."""
@@ -150,6 +151,19 @@ class NativePaper:
         ds2, dp2 = ds * ds, dp * dp
         return 0.5 * (ns * ns * dp2 + np_ * np_ * ds2) / (ds2 * dp2)
 
+    def _fresnel_t(self, cos_i, eta: float):
+        """`1 - fresnel_dielectric(cos_i, eta)` for light from outside
+        (`cos_i >= 0`), without the cancellation of `1 - F` near grazing
+        (where F -> 1): `1 - r_s^2 = 4 eta c_i c_t / d_s^2` and likewise for
+        `p`, so `T = 2 eta c_i c_t (1 / d_s^2 + 1 / d_p^2)`."""
+        dr = self.dr
+        if eta == 1.0:
+            return self.mi.Float(1.0)
+        c = dr.minimum(dr.abs(cos_i), 1.0)
+        ct = dr.safe_sqrt(1.0 - (1.0 - c * c) / (eta * eta))
+        ds, dp = c + eta * ct, ct + eta * c
+        return 2.0 * eta * c * ct * (1.0 / (ds * ds) + 1.0 / (dp * dp))
+
     def _fresnel(self, cos_i, eta: float):
         """`fresnel_dielectric(cos_i, eta)`: unpolarised reflectance, light
         from outside for `cos_i >= 0`, from inside otherwise."""
@@ -175,8 +189,8 @@ class NativePaper:
             if kind != "r" and not face.use_att:
                 v = dr.select(on, 1.0, v)
             elif face.exact_smooth:
-                fr = self._fresnel(st * st, face.eta)
-                v = dr.select(on, fr if kind == "r" else 1.0 - fr, v)
+                mu = st * st
+                v = dr.select(on, self._fresnel(mu, face.eta) if kind == "r" else self._fresnel_t(mu, face.eta), v)
         return v
 
     def _inside_cos(self, mu, inv_n2):
