@@ -24,9 +24,10 @@
 - sampling on the native path: Mitsuba's chi-square test for sheets other
   than the presets (unequal faces with a coating; the reduced multilayer
   model), from both sides (the presets are in test_mitsuba.py);
-- the plugin's ``mode``: ``auto`` is ``native`` for the paper models and
-  ``exact`` for the others, ``native`` for another model is a ValueError,
-  and the two modes agree through the plugin interface;
+- the plugin's ``mode``: ``auto`` is ``native`` for the paper models in JIT
+  variants and ``exact`` in scalar ones and for the other models,
+  ``native`` for another model is a ValueError, and the two modes agree
+  through the plugin interface;
 - register() leaves Dr.Jit's symbolic flags at Mitsuba's defaults, and a
   render with the native plugin runs in them (in a fresh process, since an
   ``exact`` plugin in a JIT variant switches them for the process).
@@ -177,12 +178,21 @@ def test_native_chi2_other_sheets(name, side):
     assert test.run(), f"{name}, side {side}: {test.messages}"
 
 
-def test_modes():
-    mi = mitsuba("scalar_rgb")
-    assert mi.load_dict({"type": "paperbsdf", "preset": "matte"}).mode == "native"
-    assert mi.load_dict({"type": "paperbsdf", "preset": "matte", "model": "reduced-multilayer"}).mode == "native"
+@pytest.mark.parametrize("variant", ["scalar_rgb", "llvm_ad_rgb"])
+def test_modes(variant):
+    """auto: native for the paper models in JIT variants, exact in scalar
+    ones (faster there) and for the other models."""
+    mi = mitsuba(variant)
+    import drjit as dr
+
+    auto = "native" if variant.startswith("llvm") else "exact"
+    assert mi.load_dict({"type": "paperbsdf", "preset": "matte"}).mode == auto
+    assert mi.load_dict({"type": "paperbsdf", "preset": "matte", "model": "reduced-multilayer"}).mode == auto
+    assert mi.load_dict({"type": "paperbsdf", "preset": "matte", "mode": "native"}).mode == "native"
+    assert dr.flag(dr.JitFlag.SymbolicLoops)  # untouched so far
     glass = json.dumps({"eta": 1.5, "m": 0.3, "dist": "ggx"})
-    assert mi.load_dict({"type": "paperbsdf", "model": "rough-dielectric", "params": glass}).mode == "exact"
+    if variant.startswith("scalar"):  # (in llvm_ad_rgb it would switch the flags for the process)
+        assert mi.load_dict({"type": "paperbsdf", "model": "rough-dielectric", "params": glass}).mode == "exact"
     with pytest.raises(ValueError, match=r"mode `native` covers the models"):
         mi.load_dict({"type": "paperbsdf", "model": "rough-dielectric", "params": glass, "mode": "native"})
     with pytest.raises(ValueError, match=r"mode `fast` is unknown"):

@@ -77,12 +77,14 @@ def measure(variant: str, bsdf: str, loops: str, spp: int) -> dict:
 
 
 RUNS = [  # (variant, bsdf, loops); spp from the arguments
-    ("scalar_rgb", "paperbsdf-native", "-"), ("scalar_rgb", "roughplastic", "-"),
+    ("scalar_rgb", "paperbsdf-native", "-"), ("scalar_rgb", "paperbsdf-exact", "-"),
+    ("scalar_rgb", "roughplastic", "-"),
     ("llvm_ad_rgb", "paperbsdf-native", "symbolic"), ("llvm_ad_rgb", "roughplastic", "symbolic"),
     ("llvm_ad_rgb", "paperbsdf-exact", "evaluated"), ("llvm_ad_rgb", "roughplastic", "evaluated"),
 ]
 RATIOS = [  # (variant, plugin bsdf, loops of both)
     ("scalar_rgb", "paperbsdf-native", "-"),
+    ("scalar_rgb", "paperbsdf-exact", "-"),
     ("llvm_ad_rgb", "paperbsdf-native", "symbolic"),
     ("llvm_ad_rgb", "paperbsdf-exact", "evaluated"),
 ]

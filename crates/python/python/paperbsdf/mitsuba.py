@@ -28,26 +28,30 @@ with ``pdf`` the lobe's probability; ``eval`` and ``pdf`` exclude them.
 
 Two evaluation paths, chosen by the property ``mode``:
 
-- ``native`` (the default for ``paper`` and ``reduced-multilayer`` in the RGB
-  variants): the model ported to Dr.Jit (:mod:`paperbsdf.mitsuba_native`,
+- ``native``: the model ported to Dr.Jit (:mod:`paperbsdf.mitsuba_native`,
   on the Rust model's own construction-time tables read by
   :mod:`paperbsdf._paper_state`), traced into Mitsuba's kernels. It runs in
   Mitsuba's default *symbolic* loops and calls in the JIT variants
-  (``llvm_ad_rgb``) and as scalar code in ``scalar_rgb``; its values are the
-  Rust model's up to float32 rounding (the tests bound the difference).
-- ``exact``: each call hands its directions to the Rust model (one native
-  call per wavefront in a JIT variant, the GIL released, all cores; one
-  direction per call in a scalar variant). The only path for
-  ``lambert-glass`` and ``rough-dielectric`` (``auto`` picks it for them).
-  In a JIT variant a wavefront must exist as data before it can go to
-  native code, which needs Dr.Jit's *evaluated* loops and calls: creating an
-  ``exact`` plugin in a JIT variant switches ``dr.JitFlag.SymbolicLoops``,
-  ``SymbolicCalls`` and ``SymbolicConditionals`` off (for the whole process;
-  :func:`register` itself leaves them as they are).
+  (``llvm_ad_rgb``), and also as scalar code in ``scalar_rgb``; its values
+  are the Rust model's up to float32 rounding (the tests bound the relative
+  difference by 2e-4). For ``paper`` and ``reduced-multilayer`` in the RGB
+  variants.
+- ``exact``: the Rust model itself. In a scalar variant one call into Rust
+  per direction; in a JIT variant one call per wavefront (the GIL
+  released, all cores). The only path for ``lambert-glass`` and
+  ``rough-dielectric``. In a JIT variant a wavefront must exist as data
+  before it can go to native code, which needs Dr.Jit's *evaluated* loops
+  and calls: creating an ``exact`` plugin in a JIT variant switches
+  ``dr.JitFlag.SymbolicLoops``, ``SymbolicCalls`` and
+  ``SymbolicConditionals`` off, for the whole process (:func:`register`
+  itself leaves them as they are).
 
-``mode = "auto"`` (the default) is ``native`` where it applies, else
-``exact``. Neither path is differentiable: gradients through the model are
-zero (the native path's tables are constants, its parameters not exposed).
+``mode = "auto"`` (the default) is ``native`` in the JIT variants and
+``exact`` in the scalar ones, where every Dr.Jit operation of the port is a
+Python call and one Rust call per direction is some 15 times faster
+(README, "Speed of the plugin"); the other models are always ``exact``.
+Neither path is differentiable: gradients through the model are zero (the
+native path's tables are constants, its parameters not exposed).
 """
 
 from __future__ import annotations
@@ -239,7 +243,9 @@ def _make_class(mi, dr):
                     f"variants, not model `{model}` in `{mi.variant()}`; use mode `exact`"
                 )
             self._native = None
-            if mode != "exact" and native_ok:
+            # auto: native in the JIT variants; in a scalar variant the exact
+            # path's one Rust call per direction is faster (module doc).
+            if native_ok and (mode == "native" or (mode == "auto" and jit)):
                 from . import mitsuba_native
                 from ._paper_state import paper_state
 
@@ -273,8 +279,8 @@ def _make_class(mi, dr):
 
         # --- helpers -------------------------------------------------------
         def _eval_pdf_np(self, si, wo, active):
-            if jit:
-                dr.eval(si.wi, wo, active)  # one kernel launch for all the inputs
+            # The exact path in a JIT variant: the wavefront to numpy and Rust.
+            dr.eval(si.wi, wo, active)  # one kernel launch for all the inputs
             n = _size(si.wi, wo, active)
             wi_v = _vec_np(si.wi, n)  # toward the viewer: paperbsdf's wo
             wo_l = _vec_np(wo, n)  # toward the light: paperbsdf's wi
@@ -311,30 +317,62 @@ def _make_class(mi, dr):
             weight = dr.select(ok, f * (dr.abs(wi.z) / dr.select(ok, pdf, 1.0)), 0.0)
             return bs, weight
 
+        # --- the exact path in a scalar variant: one direction per call ----
+        def _scalar_eval_pdf(self, si, wo, active):
+            if not active:
+                return mi.Color3f(0.0), 0.0
+            # paperbsdf's wi is Mitsuba's wo (toward the light), its wo is si.wi.
+            (r, g, b), pdf = self.model._native.eval_pdf_one((wo.x, wo.y, wo.z), (si.wi.x, si.wi.y, si.wi.z))
+            c = abs(wo.z)
+            return mi.Color3f(r * c, g * c, b * c), pdf
+
+        def _scalar_sample(self, si, sample1, sample2, active):
+            bs = mi.BSDFSample3f()
+            bs.eta = 1.0  # air on both sides of the sheet
+            if not active:
+                return bs, mi.Color3f(0.0)
+            wi, pdf, bits, (r, g, b) = self.model._native.sample_one(
+                (si.wi.x, si.wi.y, si.wi.z), (sample1, sample2.x, sample2.y))
+            if pdf <= 0.0:
+                return bs, mi.Color3f(0.0)
+            idx, flag = self._lobe_index.get(bits, (0, 0))
+            bs.wo = mi.Vector3f(*wi)
+            bs.pdf = pdf
+            bs.sampled_component = idx
+            bs.sampled_type = flag
+            return bs, mi.Color3f(r, g, b)
+
         # --- the BSDF interface ---------------------------------------------
         def eval(self, ctx, si, wo, active=True):
             if self._native is not None:
                 return self._native_eval_pdf(si, wo, active, True, False)[0]
+            if not jit:
+                return self._scalar_eval_pdf(si, wo, active)[0]
             value, _ = self._eval_pdf_np(si, wo, active)
             return to_spec(value)
 
         def pdf(self, ctx, si, wo, active=True):
             if self._native is not None:
                 return self._native_eval_pdf(si, wo, active, False, True)[1]
+            if not jit:
+                return self._scalar_eval_pdf(si, wo, active)[1]
             _, pdf = self._eval_pdf_np(si, wo, active)
             return to_float(pdf)
 
         def eval_pdf(self, ctx, si, wo, active=True):
             if self._native is not None:
                 return self._native_eval_pdf(si, wo, active, True, True)
+            if not jit:
+                return self._scalar_eval_pdf(si, wo, active)
             value, pdf = self._eval_pdf_np(si, wo, active)
             return to_spec(value), to_float(pdf)
 
         def sample(self, ctx, si, sample1, sample2, active=True):
             if self._native is not None:
                 return self._native_sample(si, sample1, sample2, active)
-            if jit:
-                dr.eval(si.wi, sample1, sample2, active)
+            if not jit:
+                return self._scalar_sample(si, sample1, sample2, active)
+            dr.eval(si.wi, sample1, sample2, active)
             n = _size(si.wi, sample1, sample2.x, active)
             wi_v = _vec_np(si.wi, n)
             u = np.empty((n, 3))
