@@ -156,7 +156,7 @@ def test_sample_wavefront_llvm(mode, restore_flags):
 @pytest.mark.parametrize("preset", ["matte", "luster", "glossy"])
 @pytest.mark.parametrize("side", [1.0, -1.0])
 def test_chi2(preset, side):
-    mi = mitsuba("llvm_ad_rgb")
+    mitsuba("llvm_ad_rgb")
     import drjit as dr
 
     assert dr.flag(dr.JitFlag.SymbolicLoops) and dr.flag(dr.JitFlag.SymbolicCalls)  # Mitsuba's default mode

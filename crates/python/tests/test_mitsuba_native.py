@@ -164,7 +164,7 @@ def test_native_eval_pdf_equal_rust(variant, name):
 @pytest.mark.parametrize("name", ["unequal-coated", "reduced-multilayer"])
 @pytest.mark.parametrize("side", [1.0, -1.0])
 def test_native_chi2_other_sheets(name, side):
-    mi = mitsuba("llvm_ad_rgb")
+    mitsuba("llvm_ad_rgb")
     from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
 
     model, params = CONFIGS[name]

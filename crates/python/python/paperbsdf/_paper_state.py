@@ -220,7 +220,7 @@ def _face(d) -> FaceState:
     lobe = np.asarray(_field(d, "lobe_tab"), dtype=np.float64)
     att = np.asarray(_field(d, "att_tab"), dtype=np.float64)
     na = att.shape[0]
-    for name, a in (("att_dir_tab", None), ("r_tab", None)):
+    for name in ("att_dir_tab", "r_tab"):
         if np.asarray(_field(d, name)).shape != (na,):
             raise PaperStateError(f"{name}: expected {na} nodes")
     if lobe.shape != (na, 2):

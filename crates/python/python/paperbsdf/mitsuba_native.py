@@ -11,7 +11,7 @@ same formulas, so the values are the Rust model's up to float32 rounding.
 
 The formulas, by docs/design.md section (and the Rust file that has them):
 
-- 4.3 surface reflection of the lit face (face.rs): Walter's rough
+- 4.1 and 4.3 surface reflection of the lit face (face.rs): Walter's rough
   dielectric lobe ``F(o.h) D G1 G1 / (4 |i.z| |o.z|)`` (GGX; Beckmann with
   Walter's rational ``G1`` in values and the exact Smith ``Lambda`` in the
   visible-normal density, as crates/core/src/microfacet.rs), plus the
@@ -25,7 +25,7 @@ The formulas, by docs/design.md section (and the Rust file that has them):
 - 4.5 multiple scattering (mod.rs): ``ms_r(e) W_e(mu_i) W_e(mu_o)`` in
   reflection, ``ms_t W_e(mu_i) W_x(mu_o)`` in transmission (the energy
   closing form; the reduced multilayer model's multipole normalisation
-  ``c Att Att``);
+  ``c Att Att``, 4.7);
 - 4.6 direct transmission (direct.rs): ``Att_dir,e Att_dir,x k(|p_o - p_i|)
   e^{-tau / min(mu_i, mu_o)}`` with the GGX or Gaussian slope kernel, or its
   delta lobe;
@@ -88,16 +88,19 @@ class NativePaper:
         self.dists = sorted(dists)
         self.kernel_delta = s.kernel == "delta"
         self.phase_on = s.phase_weight > 0.0
-        self.grey = bool(np.all(s.tau == s.tau[0]) and np.all(s.albedo == s.albedo[0]))
 
     # --- plumbing ---------------------------------------------------------
     def _buffer(self, a: np.ndarray):
         """A flat table as a Dr.Jit array that `dr.gather` reads (float32 in
         JIT variants); in scalar variants a list of Python floats, the Rust
-        model's float64 values unrounded."""
+        model's float64 values unrounded. Built from a list, so Dr.Jit
+        copies it into memory of its own (an array made from numpy memory
+        may wrap it, and the kernels would then depend on its address's
+        alignment; see `paperbsdf.mitsuba._aligned`)."""
+        values = [float(v) for v in np.asarray(a, dtype=np.float64).reshape(-1)]
         if self.jit:
-            return self.mi.Float(np.ascontiguousarray(np.asarray(a, dtype=np.float32).reshape(-1)))
-        return [float(v) for v in np.asarray(a, dtype=np.float64).reshape(-1)]
+            return self.mi.Float(values)
+        return values
 
     def _not(self, m):
         """Logical not of a mask (a Python bool in scalar variants, where `~` is not)."""
@@ -182,7 +185,7 @@ class NativePaper:
         """`Att` (`kind = "att"`), its collimated part (`"att_dir"`) or the
         outside reflectance (`"r"`) of the face on `side` at the place `pos`
         (`st = sqrt(|cos|)`), with the exact-Fresnel faces and `use_att`."""
-        mi, dr = self.mi, self.dr
+        dr = self.dr
         v = self._lerp(buf, side, pos, self.na)
         for k, face in enumerate(self.s.faces):
             on = front if k == 0 else self._not(front)
@@ -376,7 +379,8 @@ class NativePaper:
                 # Transmission: tau e^{-tau / max(mu)} h(tau |1/mu_i - 1/mu_o|) / (mu_i mu_o).
                 a, b = 1.0 / mu_i, 1.0 / mu_o
                 xt = tau * dr.abs(a - b)
-                h = dr.select(xt < _SERIES_X, 1.0 - xt * (0.5 - xt / 6.0), (1.0 - dr.exp(-xt)) / dr.maximum(xt, _SERIES_X))
+                h = dr.select(xt < _SERIES_X, 1.0 - xt * (0.5 - xt / 6.0),
+                              (1.0 - dr.exp(-xt)) / dr.maximum(xt, _SERIES_X))
                 dep_t = tau * dr.exp(-tau * dr.minimum(a, b)) * h / (mu_i * mu_o)
                 thick_t = s.tau_min > TAU_DROP * dr.maximum(mu_i, mu_o)
                 dep_t = dr.select(thick_t, 0.0, dep_t)
@@ -465,7 +469,7 @@ class NativePaper:
 
     def _direct_delta_weight(self, wi, wo, fe, fx, e, x):
         """Weight of the delta direct lobe (eval.rs `direct_delta_weight`)."""
-        mi, dr = self.mi, self.dr
+        dr = self.dr
         s = self.s
         f0, f1 = s.faces
         ai, ao = dr.abs(wi.z), dr.abs(wo.z)
