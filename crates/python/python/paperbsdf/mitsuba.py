@@ -14,7 +14,7 @@ Properties (scene XML ``<string name=... value=.../>`` or ``load_dict`` keys):
   or ``rough-dielectric``;
 - ``mode``: ``auto`` (default), ``native`` or ``exact`` (below).
 
-Conventions. Mitsuba 3 (radiance transport) gives the BSDF ``si.wi``, the
+Conventions (paperbsdf's: docs/design.md section 2). Mitsuba 3 (radiance transport) gives the BSDF ``si.wi``, the
 direction toward the previous path vertex (the viewer's side), and asks for
 or samples ``wo``, the direction toward the light; its ``eval`` includes the
 cosine ``|cos theta(wo)|`` (Mitsuba's ``diffuse``: ``reflectance / pi *
@@ -58,6 +58,7 @@ from __future__ import annotations
 
 import json
 import re
+import warnings
 
 import numpy as np
 
@@ -247,10 +248,17 @@ def _make_class(mi, dr):
             # path's one Rust call per direction is faster (module doc).
             if native_ok and (mode == "native" or (mode == "auto" and jit)):
                 from . import mitsuba_native
-                from ._paper_state import paper_state
+                from ._paper_state import PaperStateError, paper_state
 
-                self._native = mitsuba_native.NativePaper(mi, dr, paper_state(self.model._native.paper_state))
-            elif jit:
+                try:
+                    self._native = mitsuba_native.NativePaper(mi, dr, paper_state(self.model._native.paper_state))
+                except PaperStateError as e:
+                    # The core crate's layout changed under this reader: say so,
+                    # and (for auto) keep rendering on the exact path.
+                    if mode == "native":
+                        raise
+                    warnings.warn(f"paperbsdf plugin: native path unavailable ({e}); using the exact path")
+            if self._native is None and jit:
                 use_evaluated_mode()
             self.mode = "native" if self._native is not None else "exact"
             # Lobes: each kind (diffuse, glossy, delta) that the model has, in
