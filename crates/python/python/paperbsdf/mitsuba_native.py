@@ -86,6 +86,9 @@ class NativePaper:
         # with a per-lane roughness), else both, selected per side.
         dists = {f.dist for f in s.faces if f.kind == "rough"}
         self.dists = sorted(dists)
+        # Mitsuba's visible-normal samplers of those families.
+        kinds = {"ggx": mi.MicrofacetType.GGX, "beckmann": mi.MicrofacetType.Beckmann}
+        self.mf_types = {d: kinds[d] for d in self.dists}
         self.kernel_delta = s.kernel == "delta"
         self.phase_on = s.phase_weight > 0.0
 
@@ -439,14 +442,6 @@ class NativePaper:
         return dr.select(g["ok"], pdf, 0.0)
 
     # --- sample (sample.rs) -----------------------------------------------
-    def _microfacets(self):
-        """Mitsuba's visible-normal samplers of the rough faces, per family."""
-        mi = self.mi
-        if not hasattr(self, "_mf"):
-            kinds = {"ggx": mi.MicrofacetType.GGX, "beckmann": mi.MicrofacetType.Beckmann}
-            self._mf = {d: kinds[d] for d in self.dists}
-        return self._mf
-
     def _r_in_delta(self, k: int, mu_b):
         """Reflectance from inside the base of face `k` without microfacets
         (face.rs `r_in_delta`)."""
@@ -536,7 +531,7 @@ class NativePaper:
         wo_l = mi.Vector3f(wo.x, wo.y, wo.z * sx)
         wi_surf = mi.Vector3f(-wo.x, -wo.y, wo.z)  # the mirror direction (a smooth face's delta)
         rough_x = self._sel_bool(fx, self.rough[0], self.rough[1])
-        for dist, mtype in self._microfacets().items():
+        for dist, mtype in self.mf_types.items():
             uses = [fc.kind == "rough" and fc.dist == dist for fc in s.faces]
             a0 = f0.alpha if uses[0] else f1.alpha
             a1 = f1.alpha if uses[1] else f0.alpha
