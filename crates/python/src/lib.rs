@@ -304,6 +304,56 @@ impl Model {
         ))
     }
 
+    /// One direction pair without numpy, for the Mitsuba plugin's scalar
+    /// variants (one call per direction): `((r, g, b), pdf)` of `f(wi, wo)`
+    /// and `pdf(wi, wo)`. Directions that are not finite or not of unit
+    /// length (to 1e-3: Mitsuba's single precision) give zeros; the others
+    /// are normalised.
+    fn eval_pdf_one(&self, wi: (f64, f64, f64), wo: (f64, f64, f64)) -> ((f64, f64, f64), f64) {
+        let (Some(wi), Some(wo)) = (plugin_dir(wi), plugin_dir(wo)) else {
+            return ((0.0, 0.0, 0.0), 0.0);
+        };
+        let m = self.model.model();
+        let f = m.eval(wi, wo);
+        (rgb_tuple(f), m.pdf(wi, wo))
+    }
+
+    /// One draw without numpy (see [`Model::eval_pdf_one`]): for viewer `wo`
+    /// and numbers `u` in [0, 1), `(wi, pdf, flags, weight)` as in
+    /// [`Model::sample`]; a failed draw or an invalid input gives zeros.
+    #[allow(clippy::type_complexity)]
+    fn sample_one(&self, wo: (f64, f64, f64), u: (f64, f64, f64)) -> ((f64, f64, f64), f64, u8, (f64, f64, f64)) {
+        const NONE: ((f64, f64, f64), f64, u8, (f64, f64, f64)) = ((0.0, 0.0, 0.0), 0.0, 0, (0.0, 0.0, 0.0));
+        let Some(wo) = plugin_dir(wo) else { return NONE };
+        let (uc, u1, u2) = u;
+        if ![uc, u1, u2].iter().all(|x| (0.0..1.0).contains(x)) {
+            return NONE;
+        }
+        match self.model.model().sample(wo, uc, [u1, u2]) {
+            Some(s) if s.pdf > 0.0 && s.f.is_finite() => (s.wi.into(), s.pdf, s.flags.0, rgb_tuple(s.weight())),
+            _ => NONE,
+        }
+    }
+
+    /// The Paper BSDF's construction-time state (its faces' node tables, the
+    /// multiple-scattering tables, the phase function, the lobe-selection
+    /// table, the direct kernel) as the text of its `Debug` representation,
+    /// for `paper` and `reduced-multilayer`; `None` for the other models.
+    ///
+    /// `paperbsdf.mitsuba_native` reads the tables from it to evaluate the
+    /// model in Dr.Jit. `paperbsdf_core::PaperBsdf` keeps these fields
+    /// private, and `Debug` is its one complete view of them from this crate;
+    /// Rust's `Debug` prints every `f64` in its shortest round-trip form, so
+    /// the values are exact. (A layout change in core makes the reader raise,
+    /// and the Python tests compare the Dr.Jit evaluation with this model's.)
+    #[getter]
+    fn paper_state(&self) -> Option<String> {
+        match &self.model {
+            LoadedModel::Paper(m) => Some(format!("{m:?}")),
+            _ => None,
+        }
+    }
+
     /// Directional albedo for light at polar angles `theta_i_deg` (degrees, in
     /// [0, 90]) in the x-z plane arriving at the `side` face (`front`: from
     /// z > 0, `back`: from z < 0); the routine of `paperbsdf albedo`. Returns
@@ -344,6 +394,18 @@ impl Model {
         let (r, t): (Vec<Rgb>, Vec<Rgb>) = out.into_iter().unzip();
         Ok((rgb_array(r).into_pyarray(py), rgb_array(t).into_pyarray(py)))
     }
+}
+
+/// A Mitsuba direction for the one-direction calls: normalised if finite
+/// and of unit length to 1e-3 (single precision), else `None`.
+fn plugin_dir((x, y, z): (f64, f64, f64)) -> Option<DVec3> {
+    let w = DVec3::new(x, y, z);
+    let l = w.length();
+    (w.is_finite() && (l - 1.0).abs() < 1e-3).then(|| w / l)
+}
+
+fn rgb_tuple(c: Rgb) -> (f64, f64, f64) {
+    (c.0[0], c.0[1], c.0[2])
 }
 
 /// The names of the models built from parameters, from the one registry

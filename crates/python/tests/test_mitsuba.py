@@ -7,11 +7,14 @@
 - sample returns a direction toward the light whose side and weight agree
   with eval/pdf, and pdf equals the plugin's pdf for that direction;
 - Mitsuba's own chi-square test (mitsuba.chi2 with its BSDF adapter) of the
-  matte, luster and glossy presets from both sides (llvm_ad_rgb; it does not
-  run in scalar_rgb);
+  matte, luster and glossy presets from both sides (llvm_ad_rgb, the default
+  native path in Mitsuba's symbolic mode; it does not run in scalar_rgb);
 - a white furnace: a sphere of non-absorbing paper in a uniform environment of
   radiance 1 renders to 1;
 - bad properties raise ValueError from mi.load_dict.
+
+The interface tests run on both paths (``mode`` native and exact); the
+chi-square and furnace tests on the default (native) path.
 """
 
 from __future__ import annotations
@@ -47,11 +50,26 @@ def pairs():
     return out
 
 
+@pytest.fixture
+def restore_flags():
+    """Restores Dr.Jit's symbolic flags after a test (an ``exact`` plugin in a
+    JIT variant switches them off for the process)."""
+    import drjit as dr
+
+    flags = (dr.JitFlag.SymbolicLoops, dr.JitFlag.SymbolicCalls, dr.JitFlag.SymbolicConditionals)
+    saved = [dr.flag(f) for f in flags]
+    yield
+    for f, v in zip(flags, saved):
+        dr.set_flag(f, v)
+
+
+@pytest.mark.parametrize("mode", ["native", "exact"])
 @pytest.mark.parametrize("variant", ["scalar_rgb", "llvm_ad_rgb"])
-def test_eval_mapping_and_cosine(variant):
+def test_eval_mapping_and_cosine(variant, mode, restore_flags):
     mi = mitsuba(variant)
     for preset in ("matte", "glossy"):
-        plugin = mi.load_dict({"type": "paperbsdf", "preset": preset})
+        plugin = mi.load_dict({"type": "paperbsdf", "preset": preset, "mode": mode})
+        assert plugin.mode == mode
         ref = paperbsdf.PaperBsdf(preset)
         for light, viewer in pairs():
             si = mi.SurfaceInteraction3f()
@@ -73,9 +91,10 @@ def test_eval_mapping_and_cosine(variant):
             assert abs(float(np.array(p2).reshape(-1)[0]) - p) <= 1e-6 * p
 
 
-def test_sample_side_and_weight_scalar():
+@pytest.mark.parametrize("mode", ["native", "exact"])
+def test_sample_side_and_weight_scalar(mode):
     mi = mitsuba("scalar_rgb")
-    plugin = mi.load_dict({"type": "paperbsdf", "preset": "matte"})
+    plugin = mi.load_dict({"type": "paperbsdf", "preset": "matte", "mode": mode})
     ctx = mi.BSDFContext()
     rng = np.random.default_rng(5)
     n_r = n_t = 0
@@ -103,11 +122,13 @@ def test_sample_side_and_weight_scalar():
     assert n_r > 50 and n_t > 10
 
 
-def test_sample_wavefront_llvm():
+@pytest.mark.parametrize("mode", ["native", "exact"])
+def test_sample_wavefront_llvm(mode, restore_flags):
     mi = mitsuba("llvm_ad_rgb")
     import drjit as dr
 
-    plugin = mi.load_dict({"type": "paperbsdf", "preset": "luster"})
+    plugin = mi.load_dict({"type": "paperbsdf", "preset": "luster", "mode": mode})
+    assert plugin.mode == mode
     n = 10000
     rng = np.random.default_rng(9)
     v = rng.normal(size=(n, 3))
@@ -135,7 +156,10 @@ def test_sample_wavefront_llvm():
 @pytest.mark.parametrize("preset", ["matte", "luster", "glossy"])
 @pytest.mark.parametrize("side", [1.0, -1.0])
 def test_chi2(preset, side):
-    mi = mitsuba("llvm_ad_rgb")
+    mitsuba("llvm_ad_rgb")
+    import drjit as dr
+
+    assert dr.flag(dr.JitFlag.SymbolicLoops) and dr.flag(dr.JitFlag.SymbolicCalls)  # Mitsuba's default mode
     from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
 
     for theta in (20.0, 70.0):
@@ -203,6 +227,7 @@ def test_furnace_sphere_renders_one():
     scene = mi.load_dict(furnace_scene(
         mi, {"type": "sphere", "radius": 1.0, "bsdf": {"type": "paperbsdf", "params": json.dumps(params)}},
         [0, -4, 0], [0, 0, 0], 20.0, 16, 32))
+    assert scene.shapes()[0].bsdf().mode == "native"
     img = np.array(mi.render(scene, seed=4), dtype=np.float64)[..., :3]
     per_pixel = img.mean(axis=2)
     print(f"furnace: image mean {img.mean():.5f}, pixels {per_pixel.min():.4f} .. {per_pixel.max():.4f};"
@@ -231,13 +256,14 @@ def test_load_dict_errors():
     err({"model": "plastic", "params": json.dumps(p)}, r"unknown model `plastic`")
 
 
-def test_delta_lobes_are_delta_components():
+@pytest.mark.parametrize("mode", ["native", "exact"])
+def test_delta_lobes_are_delta_components(mode):
     """A smooth sheet (m = 0 on both faces): the plugin declares delta lobes,
     sample returns DeltaReflection (the mirror direction) and DeltaTransmission
     (straight through) with weight = the model's, and eval/pdf exclude them."""
     mi = mitsuba("scalar_rgb")
     p = dict(paperbsdf.preset("matte"), m_f=0.0, m_b=0.0, d=0.03, sigma_s=20.0)
-    plugin = mi.load_dict({"type": "paperbsdf", "params": json.dumps(p)})
+    plugin = mi.load_dict({"type": "paperbsdf", "params": json.dumps(p), "mode": mode})
     F = mi.BSDFFlags
     assert mi.has_flag(plugin.flags(), F.DeltaReflection) and mi.has_flag(plugin.flags(), F.DeltaTransmission)
     ref = paperbsdf.PaperBsdf(p)

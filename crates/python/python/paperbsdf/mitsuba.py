@@ -11,9 +11,10 @@ Properties (scene XML ``<string name=... value=.../>`` or ``load_dict`` keys):
   (docs/design.md section 3), or
 - ``preset``: ``matte``, ``luster`` or ``glossy``;
 - ``model``: ``paper`` (default), ``reduced-multilayer``, ``lambert-glass``
-  or ``rough-dielectric``.
+  or ``rough-dielectric``;
+- ``mode``: ``auto`` (default), ``native`` or ``exact`` (below).
 
-Conventions. Mitsuba 3 (radiance transport) gives the BSDF ``si.wi``, the
+Conventions (paperbsdf's: docs/design.md section 2). Mitsuba 3 (radiance transport) gives the BSDF ``si.wi``, the
 direction toward the previous path vertex (the viewer's side), and asks for
 or samples ``wo``, the direction toward the light; its ``eval`` includes the
 cosine ``|cos theta(wo)|`` (Mitsuba's ``diffuse``: ``reflectance / pi *
@@ -25,26 +26,47 @@ and transmission). Delta lobes (a smooth face, m = 0, or an index-matched
 one) are returned by ``sample`` as ``DeltaReflection``/``DeltaTransmission``
 with ``pdf`` the lobe's probability; ``eval`` and ``pdf`` exclude them.
 
-Variants. In a scalar variant (``scalar_rgb``) each call is one direction.
-In a JIT variant (``llvm_ad_rgb``) each call hands the whole wavefront to
-Rust (one native call per wavefront, the GIL released, all cores); this
-needs Dr.Jit's *evaluated* loops and calls, which :func:`register` selects
-(``dr.JitFlag.SymbolicLoops`` and ``SymbolicCalls`` off), because a
-recorded (symbolic) kernel cannot call into native code. The model is not
-differentiable: gradients through it are zero.
+Two evaluation paths, chosen by the property ``mode``:
+
+- ``native``: the model ported to Dr.Jit (:mod:`paperbsdf.mitsuba_native`,
+  on the Rust model's own construction-time tables read by
+  :mod:`paperbsdf._paper_state`), traced into Mitsuba's kernels. It runs in
+  Mitsuba's default *symbolic* loops and calls in the JIT variants
+  (``llvm_ad_rgb``), and also as scalar code in ``scalar_rgb``; its values
+  are the Rust model's up to float32 rounding (the tests bound the relative
+  difference by 2e-4). For ``paper`` and ``reduced-multilayer`` in the RGB
+  variants.
+- ``exact``: the Rust model itself. In a scalar variant one call into Rust
+  per direction; in a JIT variant one call per wavefront (the GIL
+  released, all cores). The only path for ``lambert-glass`` and
+  ``rough-dielectric``. In a JIT variant a wavefront must exist as data
+  before it can go to native code, which needs Dr.Jit's *evaluated* loops
+  and calls: creating an ``exact`` plugin in a JIT variant switches
+  ``dr.JitFlag.SymbolicLoops``, ``SymbolicCalls`` and
+  ``SymbolicConditionals`` off, for the whole process (:func:`register`
+  itself leaves them as they are).
+
+``mode = "auto"`` (the default) is ``native`` in the JIT variants and
+``exact`` in the scalar ones, where every Dr.Jit operation of the port is a
+Python call and one Rust call per direction is some 15 times faster
+(README, "Speed of the plugin"); the other models are always ``exact``.
+Neither path is differentiable: gradients through the model are zero (the
+native path's tables are constants, its parameters not exposed).
 """
 
 from __future__ import annotations
 
 import json
 import re
+import warnings
 
 import numpy as np
 
 import paperbsdf as _pb
 
 PLUGIN_NAME = "paperbsdf"
-_PROPERTIES = ("params", "preset", "model")
+_PROPERTIES = ("params", "preset", "model", "mode")
+_MODES = ("auto", "native", "exact")
 
 _registered_variants: set = set()
 
@@ -109,22 +131,28 @@ def _aligned(a: np.ndarray, dtype) -> np.ndarray:
 def register() -> None:
     """Registers the BSDF plugin ``"paperbsdf"`` for the current Mitsuba
     variant (call after ``mi.set_variant``; again after switching variants).
-    In a JIT variant it switches Dr.Jit to evaluated loops and calls (see the
-    module doc)."""
+    Dr.Jit's flags are left as they are (see the module doc for the
+    ``exact`` path, which switches them when such a plugin is created)."""
     import drjit as dr
     import mitsuba as mi
 
     variant = mi.variant()
     if variant is None:
         raise ValueError("paperbsdf.mitsuba.register(): set a Mitsuba variant first (mi.set_variant)")
-    if dr.is_jit_v(mi.Float):
-        dr.set_flag(dr.JitFlag.SymbolicLoops, False)
-        dr.set_flag(dr.JitFlag.SymbolicCalls, False)
-        dr.set_flag(dr.JitFlag.SymbolicConditionals, False)
     cls = _make_class(mi, dr)
     mi.register_bsdf(PLUGIN_NAME, lambda props: cls(props))
     _registered_variants.add(variant)
     _wrap_loaders(mi)
+
+
+def use_evaluated_mode() -> None:
+    """Switches Dr.Jit to evaluated loops, calls and conditionals, which the
+    ``exact`` path needs in a JIT variant (module doc)."""
+    import drjit as dr
+
+    dr.set_flag(dr.JitFlag.SymbolicLoops, False)
+    dr.set_flag(dr.JitFlag.SymbolicCalls, False)
+    dr.set_flag(dr.JitFlag.SymbolicConditionals, False)
 
 
 _VALUE_ERROR = re.compile(r"^ValueError: (.*)$", re.M)
@@ -163,6 +191,7 @@ def _wrap_loaders(mi) -> None:
 
 def _make_class(mi, dr):
     jit = dr.is_jit_v(mi.Float)
+    rgb = "_rgb" in mi.variant()
     F = mi.BSDFFlags
 
     def to_float(a: np.ndarray):
@@ -203,8 +232,35 @@ def _make_class(mi, dr):
                     raise ValueError("paperbsdf plugin: property `params` must be a string (inline JSON or a file path)")
             else:
                 raise ValueError("paperbsdf plugin: give the property `params` (inline JSON or a file) or `preset`")
+            mode = props["mode"] if "mode" in props else "auto"
+            if mode not in _MODES:
+                raise ValueError(f"paperbsdf plugin: mode `{mode}` is unknown; known modes: {', '.join(_MODES)}")
             self.model = _pb.Bsdf(model, params)
             self._source = params if isinstance(params, str) else json.dumps(params)
+            native_ok = model in _pb._PAPER_MODELS and rgb and self.model._native.paper_state is not None
+            if mode == "native" and not native_ok:
+                raise ValueError(
+                    f"paperbsdf plugin: mode `native` covers the models {', '.join(_pb._PAPER_MODELS)} in RGB "
+                    f"variants, not model `{model}` in `{mi.variant()}`; use mode `exact`"
+                )
+            self._native = None
+            # auto: native in the JIT variants; in a scalar variant the exact
+            # path's one Rust call per direction is faster (module doc).
+            if native_ok and (mode == "native" or (mode == "auto" and jit)):
+                from . import mitsuba_native
+                from ._paper_state import PaperStateError, paper_state
+
+                try:
+                    self._native = mitsuba_native.NativePaper(mi, dr, paper_state(self.model._native.paper_state))
+                except PaperStateError as e:
+                    # The core crate's layout changed under this reader: say so,
+                    # and (for auto) keep rendering on the exact path.
+                    if mode == "native":
+                        raise
+                    warnings.warn(f"paperbsdf plugin: native path unavailable ({e}); using the exact path")
+            if self._native is None and jit:
+                use_evaluated_mode()
+            self.mode = "native" if self._native is not None else "exact"
             # Lobes: each kind (diffuse, glossy, delta) that the model has, in
             # reflection and in transmission, on both sides.
             sides = F.FrontSide | F.BackSide
@@ -231,8 +287,8 @@ def _make_class(mi, dr):
 
         # --- helpers -------------------------------------------------------
         def _eval_pdf_np(self, si, wo, active):
-            if jit:
-                dr.eval(si.wi, wo, active)  # one kernel launch for all the inputs
+            # The exact path in a JIT variant: the wavefront to numpy and Rust.
+            dr.eval(si.wi, wo, active)  # one kernel launch for all the inputs
             n = _size(si.wi, wo, active)
             wi_v = _vec_np(si.wi, n)  # toward the viewer: paperbsdf's wo
             wo_l = _vec_np(wo, n)  # toward the light: paperbsdf's wi
@@ -243,22 +299,88 @@ def _make_class(mi, dr):
             pdf[~ok] = 0.0
             return value, pdf
 
+        # --- the native path --------------------------------------------------
+        def _native_eval_pdf(self, si, wo, active, want_f, want_pdf):
+            # Mitsuba's wo (toward the light) is paperbsdf's wi; si.wi is its wo.
+            f, pdf = self._native.eval_pdf(wo, si.wi, active, want_f, want_pdf)
+            if want_f:
+                f = f * dr.abs(wo.z)
+            return f, pdf
+
+        def _native_sample(self, si, sample1, sample2, active):
+            wi, f, pdf, bits, _delta = self._native.sample(si.wi, sample1, sample2, active)
+            U = mi.UInt32
+            comp, stype = U(0), U(0)
+            for b, (idx, flag) in self._lobe_index.items():
+                hit = bits == b
+                comp = dr.select(hit, U(idx), comp)
+                stype = dr.select(hit, U(flag), stype)
+            ok = pdf > 0.0
+            bs = dr.zeros(mi.BSDFSample3f)
+            bs.wo = wi
+            bs.pdf = pdf
+            bs.eta = mi.Float(1.0)  # air on both sides of the sheet
+            bs.sampled_component = comp
+            bs.sampled_type = dr.select(ok, stype, U(0))
+            weight = dr.select(ok, f * (dr.abs(wi.z) / dr.select(ok, pdf, 1.0)), 0.0)
+            return bs, weight
+
+        # --- the exact path in a scalar variant: one direction per call ----
+        def _scalar_eval_pdf(self, si, wo, active):
+            if not active:
+                return mi.Color3f(0.0), 0.0
+            # paperbsdf's wi is Mitsuba's wo (toward the light), its wo is si.wi.
+            (r, g, b), pdf = self.model._native.eval_pdf_one((wo.x, wo.y, wo.z), (si.wi.x, si.wi.y, si.wi.z))
+            c = abs(wo.z)
+            return mi.Color3f(r * c, g * c, b * c), pdf
+
+        def _scalar_sample(self, si, sample1, sample2, active):
+            bs = mi.BSDFSample3f()
+            bs.eta = 1.0  # air on both sides of the sheet
+            if not active:
+                return bs, mi.Color3f(0.0)
+            wi, pdf, bits, (r, g, b) = self.model._native.sample_one(
+                (si.wi.x, si.wi.y, si.wi.z), (sample1, sample2.x, sample2.y))
+            if pdf <= 0.0:
+                return bs, mi.Color3f(0.0)
+            idx, flag = self._lobe_index.get(bits, (0, 0))
+            bs.wo = mi.Vector3f(*wi)
+            bs.pdf = pdf
+            bs.sampled_component = idx
+            bs.sampled_type = flag
+            return bs, mi.Color3f(r, g, b)
+
         # --- the BSDF interface ---------------------------------------------
         def eval(self, ctx, si, wo, active=True):
+            if self._native is not None:
+                return self._native_eval_pdf(si, wo, active, True, False)[0]
+            if not jit:
+                return self._scalar_eval_pdf(si, wo, active)[0]
             value, _ = self._eval_pdf_np(si, wo, active)
             return to_spec(value)
 
         def pdf(self, ctx, si, wo, active=True):
+            if self._native is not None:
+                return self._native_eval_pdf(si, wo, active, False, True)[1]
+            if not jit:
+                return self._scalar_eval_pdf(si, wo, active)[1]
             _, pdf = self._eval_pdf_np(si, wo, active)
             return to_float(pdf)
 
         def eval_pdf(self, ctx, si, wo, active=True):
+            if self._native is not None:
+                return self._native_eval_pdf(si, wo, active, True, True)
+            if not jit:
+                return self._scalar_eval_pdf(si, wo, active)
             value, pdf = self._eval_pdf_np(si, wo, active)
             return to_spec(value), to_float(pdf)
 
         def sample(self, ctx, si, sample1, sample2, active=True):
-            if jit:
-                dr.eval(si.wi, sample1, sample2, active)
+            if self._native is not None:
+                return self._native_sample(si, sample1, sample2, active)
+            if not jit:
+                return self._scalar_sample(si, sample1, sample2, active)
+            dr.eval(si.wi, sample1, sample2, active)
             n = _size(si.wi, sample1, sample2.x, active)
             wi_v = _vec_np(si.wi, n)
             u = np.empty((n, 3))
@@ -293,6 +415,6 @@ def _make_class(mi, dr):
             pass
 
         def to_string(self):
-            return f"PaperBsdfPlugin[model={self.model.model!r}, params={self._source!r}]"
+            return f"PaperBsdfPlugin[model={self.model.model!r}, mode={self.mode!r}, params={self._source!r}]"
 
     return PaperBsdfPlugin
