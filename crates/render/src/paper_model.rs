@@ -1,6 +1,7 @@
 //! The bridge to the Paper BSDF of `paperbsdf-core` (Papas, de Mesa, Jensen,
 //! EGSR 2014): building it from parameters and looking up named presets
-//! (`paperbsdf_core::presets`).
+//! (`paperbsdf_core::presets`); and to the model `slab` (`paperbsdf_slab`),
+//! the same sheet solved numerically.
 
 use paperbsdf_core::paper::PaperBsdf;
 use paperbsdf_core::{Bsdf, PaperParams, ParamError};
@@ -9,6 +10,20 @@ use std::sync::Arc;
 /// Builds the Paper BSDF for `p` (validating the parameters).
 pub fn paper_bsdf(p: &PaperParams) -> Result<Arc<dyn Bsdf>, ParamError> {
     Ok(Arc::new(PaperBsdf::new(p)?))
+}
+
+/// Builds the model `slab` for `p`: the same sheet solved by adding-doubling
+/// (`paperbsdf_slab::SlabBsdf`); its errors as parameter errors (the
+/// parameter's name and range, or `model` for what the solver does not support).
+pub fn slab_bsdf(p: &PaperParams) -> Result<Arc<dyn Bsdf>, ParamError> {
+    match paperbsdf_slab::SlabBsdf::new(p) {
+        Ok(b) => Ok(Arc::new(b)),
+        Err(paperbsdf_slab::SlabError::Param(e)) => Err(e),
+        Err(e) => Err(ParamError::Invalid {
+            name: "model".to_string(),
+            message: format!("`slab`: {e}"),
+        }),
+    }
 }
 
 /// The parameters of a named preset, if there is one.

@@ -74,6 +74,27 @@ fn good_scene_loads() {
     load_scene(&p).unwrap();
 }
 
+/// `model = "slab"` loads (the sheet solved numerically); an unknown model
+/// names the allowed values; a sheet `slab` does not support names why.
+#[test]
+fn paper_model_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("scene.toml");
+    let slab = GOOD.replace("preset = \"matte\"", "preset = \"matte\"\nmodel = \"slab\"");
+    std::fs::write(&p, &slab).unwrap();
+    load_scene(&p).unwrap();
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace("preset = \"matte\"", "preset = \"matte\"\nmodel = \"slap\""),
+    );
+    contains_all(&m, &["materials.sheet", "slap", "paper", "slab"]);
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace("preset = \"matte\"", "preset = \"glossy\"\nmodel = \"slab\""),
+    );
+    contains_all(&m, &["materials.sheet", "slab", "eta_f != eta_b"]);
+}
+
 #[test]
 fn unknown_key() {
     let dir = tempfile::tempdir().unwrap();

@@ -16,12 +16,21 @@
 //! `sqrt(mean(ln((f_model + e) / (f_sim + e))^2))` with `e = 1e-3`, the
 //! albedo errors, and which component (surface/unscattered = order 0, single =
 //! order 1, multiple = order >= 2) carries the largest error.
+//!
+//! With `--slab` it compares both models, the Paper BSDF and the numerical
+//! model `slab` (`paperbsdf_slab::SlabBsdf`, adding-doubling), against the same
+//! simulations and writes `DIR/accuracy_slab.md` (`accuracy_single_slab.md`)
+//! instead: per case and incident angle the RMS log errors of both, the
+//! noise floor, and `slab`'s albedo and component errors (its `multiple`
+//! holds every scattering order, so orders 1 and 2+ are compared together).
 
 use paperbsdf_core::bsdf::sampled_albedo;
 use paperbsdf_core::geometry::in_plane_directions;
+use paperbsdf_core::models::ComponentModel;
 use paperbsdf_core::paper::{Component, PaperBsdf};
 use paperbsdf_core::{Bsdf, Colour, Distribution, PaperParams, Rgb};
 use paperbsdf_sim::{simulate_bsdf, Estimate, SimConfig, Slab};
+use paperbsdf_slab::SlabBsdf;
 use plotters::prelude::*;
 use std::fmt::Write as _;
 
@@ -135,6 +144,9 @@ struct Point {
     model: Rgb,
     /// Model split like the simulator's orders: surface + direct, single, multiple.
     model_order: [Rgb; 3],
+    /// `slab` (with `--slab`): its value, and its surface + direct and its
+    /// scattered part (every order).
+    slab: Option<(Rgb, [Rgb; 2])>,
 }
 
 struct AngleResult {
@@ -144,6 +156,8 @@ struct AngleResult {
     sim_t: Estimate,
     model_r: Rgb,
     model_t: Rgb,
+    /// `slab`'s directional albedo (with `--slab`).
+    slab_rt: Option<(Rgb, Rgb)>,
 }
 
 fn log_err(m: f64, s: f64) -> f64 {
@@ -159,15 +173,45 @@ fn channels(p: &PaperParams) -> usize {
 }
 
 fn rms_log(points: &[&Point], nc: usize) -> f64 {
+    rms_log_of(points, nc, |p| p.model)
+}
+
+/// [`rms_log`] of the model values `value(point)`.
+fn rms_log_of(points: &[&Point], nc: usize, value: impl Fn(&Point) -> Rgb) -> f64 {
     let mut s = 0.0;
     let mut n = 0;
     for p in points {
+        let v = value(p);
         for c in 0..nc {
-            s += log_err(p.model.0[c], p.sim.mean.0[c]).powi(2);
+            s += log_err(v.0[c], p.sim.mean.0[c]).powi(2);
             n += 1;
         }
     }
     (s / n.max(1) as f64).sqrt()
+}
+
+/// `slab`'s component errors: order 0 against its surface + direct, orders
+/// 1 and 2+ together against its scattered part (as [`component_errors`]).
+fn slab_component_errors(points: &[&Point], nc: usize) -> [f64; 2] {
+    let mut out = [0.0; 2];
+    for (k, o) in out.iter_mut().enumerate() {
+        let mut s = 0.0;
+        let mut n = 0;
+        for p in points {
+            let Some((_, parts)) = &p.slab else { continue };
+            for c in 0..nc {
+                let sim = if k == 0 {
+                    p.sim_order[0].mean.0[c]
+                } else {
+                    p.sim_order[1].mean.0[c] + p.sim_order[2].mean.0[c]
+                };
+                s += ((parts[k].0[c] - sim) / (p.sim.mean.0[c] + E_LOG)).powi(2);
+                n += 1;
+            }
+        }
+        *o = (s / n.max(1) as f64).sqrt();
+    }
+    out
 }
 
 /// The RMS log error the simulation's own noise alone would give: sqrt(mean((se / (f + e))^2)).
@@ -295,12 +339,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut out_dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs").to_string();
     let mut only: Option<String> = None;
     let mut faces = paperbsdf_core::FaceScattering::Multiple;
+    let mut with_slab = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--walks" => walks = args.next().ok_or("--walks needs a number")?.parse()?,
             "--out-dir" => out_dir = args.next().ok_or("--out-dir needs a directory")?,
             "--only" => only = Some(args.next().ok_or("--only needs a case name")?),
+            "--slab" => with_slab = true,
             "--face-scattering" => {
                 faces = args
                     .next()
@@ -310,13 +356,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             _ => {
                 return Err(format!(
-                "unknown argument `{a}` (use --walks N, --out-dir DIR, --only CASE, --face-scattering single|multiple)"
+                "unknown argument `{a}` (use --walks N, --out-dir DIR, --only CASE, --face-scattering single|multiple, --slab)"
             )
                 .into())
             }
         }
     }
     let t_start = std::time::Instant::now();
+    let mut slab_rows = String::new();
+    let mut worst_slab = 0.0f64;
     let mut md = String::new();
     let mut summary = String::new();
     let mut details = String::new();
@@ -334,6 +382,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         eprintln!("{name} ...");
         let slab = Slab::from_params(&p)?;
         let model = PaperBsdf::new(&p)?;
+        let slab_model = if with_slab {
+            let t0 = std::time::Instant::now();
+            match SlabBsdf::new(&p) {
+                Ok(b) => {
+                    eprintln!("  slab built in {:.2} s", t0.elapsed().as_secs_f64());
+                    Some(b)
+                }
+                Err(e) => {
+                    writeln!(slab_rows, "| {name} | - | not supported by `slab` yet: {e} | | | |")?;
+                    None
+                }
+            }
+        } else {
+            None
+        };
         let nc = channels(&p);
         let tos: Vec<f64> = (-8..=8).map(|k| 10.0 * k as f64).collect();
         let mut res = Vec::new();
@@ -374,6 +437,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                             comp(Component::Single),
                             comp(Component::Multiple),
                         ],
+                        slab: slab_model.as_ref().map(|b| {
+                            (
+                                b.eval(wi, wo),
+                                [
+                                    b.eval_component(wi, wo, Component::Surface)
+                                        + b.eval_component(wi, wo, Component::Direct),
+                                    b.eval_component(wi, wo, Component::Multiple),
+                                ],
+                            )
+                        }),
                     }
                 })
                 .collect();
@@ -385,7 +458,36 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 sim_t: run.transmittance,
                 model_r: mr,
                 model_t: mt,
+                slab_rt: slab_model.as_ref().map(|b| sampled_albedo(b, wi, 96)),
             });
+        }
+        if slab_model.is_some() {
+            for (kind_t, kind) in [(false, "R"), (true, "T")] {
+                for r in &res {
+                    let pts: Vec<&Point> = r.points.iter().filter(|p| p.transmission == kind_t).collect();
+                    let e_paper = rms_log(&pts, nc);
+                    let e_slab = rms_log_of(&pts, nc, |p| p.slab.as_ref().map_or(Rgb::ZERO, |s| s.0));
+                    let floor = noise_floor(&pts, nc);
+                    let (sr, st) = r.slab_rt.expect("slab albedo");
+                    let (ma, sa) = if kind_t { (st, r.sim_t) } else { (sr, r.sim_r) };
+                    let ce = slab_component_errors(&pts, nc);
+                    worst_slab = worst_slab.max(e_slab);
+                    writeln!(
+                        slab_rows,
+                        "| {name} | {} {kind} | {e_paper:.3} | **{e_slab:.3}** | {floor:.3} | {:.4} / {:.4} +- {:.4} | {:.3} / {:.3} |",
+                        r.theta_i,
+                        ma.mean(),
+                        sa.mean.mean(),
+                        sa.stderr.mean(),
+                        ce[0],
+                        ce[1]
+                    )?;
+                }
+            }
+            continue;
+        }
+        if with_slab {
+            continue;
         }
         let svg = format!("{prefix}_{name}.svg");
         plot(
@@ -454,6 +556,31 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ORDER_NAMES[k]
             )?;
         }
+    }
+    if with_slab {
+        let path = format!("{out_dir}/{prefix}_slab.md");
+        let mut md = String::new();
+        writeln!(
+            md,
+            "# `slab` and `paper` against the Monte Carlo ground truth: `face_scattering = \"{}\"`\n\n\
+Generated by `cargo run --release -p paperbsdf-sim --example accuracy -- --slab --face-scattering {} --walks {walks}` \
+({walks} walks per incident angle and channel, {:.0} s): the cases and metrics of [{prefix}.md]({prefix}.md), with the numerical \
+model `slab` (`paperbsdf_slab::SlabBsdf`, default options) beside the Paper BSDF, against the same simulations. \
+RMS log errors over `theta_o = -80..80` step 10; the noise floor is the RMS log error that the simulation's own standard \
+errors alone give (an error at the floor is not resolved); albedo: `slab`'s directional albedo against the simulated total. \
+Component errors of `slab`: order 0 (lit face, unscattered light) against its surface + direct, orders 1 and 2+ together \
+against its scattered part. Largest `slab` RMS log error: {worst_slab:.3}.\n\n\
+| case | theta_i, kind | paper RMS log error | slab RMS log error | noise floor | slab albedo / sim (+- stderr) | slab component errors (order 0 / scattered) |\n\
+|---|---|---|---|---|---|---|\n{slab_rows}",
+            faces.name(),
+            faces.name(),
+            t_start.elapsed().as_secs_f64()
+        )?;
+        let tmp = format!("{path}.tmp");
+        std::fs::write(&tmp, md)?;
+        std::fs::rename(&tmp, &path)?;
+        eprintln!("wrote {path}");
+        return Ok(());
     }
     writeln!(
         md,

@@ -41,9 +41,12 @@
 //! **Sampling.** A mixture of (a) the lit face's visible-normal sampling
 //! (core's), (b) its delta lobes, and (c) the table: for each node of `wo`, a
 //! piecewise-constant density over cells of `(hemisphere, mu_i, |phi|)`
-//! (bins in `mu` between the midpoints of the nodes, `phi_bins` uniform bins
-//! in `[0, pi]`, either sign of `phi` with probability 1/2) whose cell
-//! weights are `f |cos| dmu dphi` at the cell centre, with `wi`'s density
+//! (`mu_bins` uniform bins in `mu`, `phi_bins` uniform bins in `[0, pi]`,
+//! either sign of `phi` with probability 1/2; uniform rather than following
+//! the Radau nodes, whose last intervals near `mu = 1` are so small that a
+//! density concentrated there is hard to integrate), constant in `mu` and
+//! linear in `|phi|` within a cell, so continuous in azimuth (its values at
+//! the bin edges in `phi` are `f |cos|` at the bin's middle `mu`), with `wi`'s density
 //! taken from `f(wo -> wi)` by reciprocity; `wo` off the nodes mixes the two
 //! neighbouring nodes' densities with the interpolation weights. A share
 //! [`COSINE_SHARE`] of the table's draws is cosine-weighted over both
@@ -87,6 +90,8 @@ pub struct SlabOptions {
     pub orders: usize,
     /// Bins in `|phi|` of the sampling density, 1 to 1024.
     pub phi_bins: usize,
+    /// Bins in `mu` (per hemisphere) of the sampling density, 1 to 1024.
+    pub mu_bins: usize,
 }
 
 impl Default for SlabOptions {
@@ -96,6 +101,7 @@ impl Default for SlabOptions {
             tir_nodes: 16,
             orders: 32,
             phi_bins: 32,
+            mu_bins: 32,
         }
     }
 }
@@ -131,6 +137,9 @@ struct CellDensity {
     cdf: Vec<f64>,
     /// The cells' probabilities.
     prob: Vec<f64>,
+    /// The density (solid angle) at the `phi` edges of the cells, per `(h, k)`
+    /// `phi_bins + 1` values: linear in `|phi|` between them.
+    edge: Vec<f64>,
 }
 
 /// The `slab` model (module doc).
@@ -148,8 +157,8 @@ pub struct SlabBsdf {
     direct: [[Vec<Rgb>; 2]; 2],
     /// Delta lobes of two smooth faces.
     smooth: Option<SmoothSheet>,
-    /// Bin edges in `mu` of the sampling cells: 0, the nodes' midpoints, 1.
-    edges: Vec<f64>,
+    /// Bins in `mu` (uniform) and in `|phi|` (uniform on `[0, pi]`) of the sampling cells.
+    mu_bins: usize,
     phi_bins: usize,
     /// `[side of wo][node]`: the table's sampling density.
     cells: [Vec<CellDensity>; 2],
@@ -207,12 +216,14 @@ impl SlabBsdf {
                 range: "[1, 128]",
             });
         }
-        if opts.phi_bins == 0 || opts.phi_bins > 1024 {
-            return Err(SlabError::Discretisation {
-                name: "phi_bins",
-                value: opts.phi_bins as f64,
-                range: "[1, 1024]",
-            });
+        for (name, v) in [("phi_bins", opts.phi_bins), ("mu_bins", opts.mu_bins)] {
+            if v == 0 || v > 1024 {
+                return Err(SlabError::Discretisation {
+                    name,
+                    value: v as f64,
+                    range: "[1, 1024]",
+                });
+            }
         }
         let paper = PaperBsdf::new(p)?;
         let specs = [
@@ -298,12 +309,6 @@ impl SlabBsdf {
             eta: specs[0].front.eta(),
             tau: Rgb([specs[0].medium.tau, specs[1].medium.tau, specs[2].medium.tau]),
         });
-        let mut edges = Vec::with_capacity(n + 1);
-        edges.push(0.0);
-        for k in 0..n - 1 {
-            edges.push(0.5 * (g.mu[k] + g.mu[k + 1]));
-        }
-        edges.push(1.0);
         let front_smooth = paper.face_is_smooth(Side::Front);
         let back_smooth = paper.face_is_smooth(Side::Back);
         let mut flags = BsdfFlags::REFLECTION | BsdfFlags::TRANSMISSION | BsdfFlags::DIFFUSE;
@@ -320,7 +325,7 @@ impl SlabBsdf {
             table,
             direct,
             smooth,
-            edges,
+            mu_bins: opts.mu_bins,
             phi_bins: opts.phi_bins,
             cells: [Vec::new(), Vec::new()],
             table_albedo: [Vec::new(), Vec::new()],
@@ -336,28 +341,37 @@ impl SlabBsdf {
     }
 
     /// The sampling density of the table for `wo` at cosine `mu_o` on `side`,
-    /// and the table's albedo there (channel mean).
+    /// and the table's albedo there (channel mean): per `(h, k)` the values
+    /// `f |cos| dmu` at the `phi_bins + 1` bin edges in `|phi|`, a cell's
+    /// weight the trapezoid of its two edges.
     fn cell_density(&self, side: Side, mu_o: f64) -> (CellDensity, f64) {
-        let n = self.mu.len();
+        let nb = self.mu_bins;
         let pb = self.phi_bins;
         let dphi = PI / pb as f64;
+        let dmu = 1.0 / nb as f64;
         let so = (1.0 - mu_o * mu_o).max(0.0).sqrt();
         let wo = DVec3::new(so, 0.0, side.sign() * mu_o);
-        let mut prob = Vec::with_capacity(2 * n * pb);
+        let mut edge = Vec::with_capacity(2 * nb * (pb + 1));
         for h in 0..2 {
             let z_sign = if h == 0 { side.sign() } else { -side.sign() };
-            for k in 0..n {
-                let (e0, e1) = (self.edges[k], self.edges[k + 1]);
-                let mu = 0.5 * (e0 + e1);
+            for k in 0..nb {
+                let mu = (k as f64 + 0.5) * dmu;
                 let s = (1.0 - mu * mu).max(0.0).sqrt();
-                for b in 0..pb {
-                    let phi = (b as f64 + 0.5) * dphi;
+                for b in 0..=pb {
+                    let phi = b as f64 * dphi;
                     // wi toward the light: propagation azimuth differs by phi
                     // from wo's, so wi's azimuth is pi + phi (module doc).
                     let wi = DVec3::new(-s * phi.cos(), -s * phi.sin(), z_sign * mu);
-                    let f = self.eval_table(&self.table, wo, wi).mean().max(0.0);
-                    prob.push(f * mu * (e1 - e0) * dphi * 2.0);
+                    edge.push(self.eval_table(&self.table, wo, wi).mean().max(0.0) * mu);
                 }
+            }
+        }
+        // Cell weights (both signs of phi): the trapezoid in phi times dmu.
+        let mut prob = Vec::with_capacity(2 * nb * pb);
+        for hk in 0..2 * nb {
+            for b in 0..pb {
+                let (a, c) = (edge[hk * (pb + 1) + b], edge[hk * (pb + 1) + b + 1]);
+                prob.push(0.5 * (a + c) * dmu * dphi * 2.0);
             }
         }
         let total: f64 = prob.iter().sum();
@@ -369,10 +383,13 @@ impl SlabBsdf {
                 acc += *p;
                 cdf.push(acc);
             }
+            for v in edge.iter_mut() {
+                *v /= total;
+            }
         } else {
             cdf.resize(prob.len(), 0.0);
         }
-        (CellDensity { cdf, prob }, total)
+        (CellDensity { cdf, prob, edge }, total)
     }
 
     /// The table `tab` at `(wi, wo)` (module doc), before clamping.
@@ -437,7 +454,7 @@ impl SlabBsdf {
             .cells
             .iter()
             .flat_map(|s| s.iter())
-            .map(|c| (c.cdf.len() + c.prob.len()) * 8)
+            .map(|c| (c.cdf.len() + c.prob.len() + c.edge.len()) * 8)
             .sum();
         tables + cells
     }
@@ -480,14 +497,16 @@ impl SlabBsdf {
         let side = Side::of(wo);
         let (j, t) = locate(&self.mu, wo.z.abs());
         let h = usize::from(wi.z * wo.z <= 0.0);
-        let k = (self.edges.partition_point(|&e| e <= wi.z.abs()).max(1) - 1).min(self.mu.len() - 1);
+        let k = ((wi.z.abs() * self.mu_bins as f64) as usize).min(self.mu_bins - 1);
         let dphi = PI / self.phi_bins as f64;
         let phi = cos_phi(wi, wo).acos();
-        let b = ((phi / dphi) as usize).min(self.phi_bins - 1);
-        let cell = (h * self.mu.len() + k) * self.phi_bins + b;
-        let area = 2.0 * (self.edges[k + 1] - self.edges[k]) * dphi;
+        let x = phi / dphi;
+        let b = (x as usize).min(self.phi_bins - 1);
+        let x = x - b as f64;
+        let e = (h * self.mu_bins + k) * (self.phi_bins + 1) + b;
         let cells = &self.cells[side as usize];
-        let p_tab = (cells[j].prob[cell] * (1.0 - t) + cells[j + 1].prob[cell] * t) / area;
+        let density = |c: &CellDensity| c.edge[e] * (1.0 - x) + c.edge[e + 1] * x;
+        let p_tab = density(&cells[j]) * (1.0 - t) + density(&cells[j + 1]) * t;
         (1.0 - COSINE_SHARE) * p_tab + COSINE_SHARE * wi.z.abs() / (2.0 * PI)
     }
 
@@ -517,11 +536,20 @@ impl SlabBsdf {
         let lo = if cell == 0 { 0.0 } else { cd.cdf[cell - 1] };
         let sign = if (v - lo) / cd.prob[cell] < 0.5 { 1.0 } else { -1.0 };
         let pb = self.phi_bins;
-        let n = self.mu.len();
-        let (h, rest) = (cell / (n * pb), cell % (n * pb));
+        let nb = self.mu_bins;
+        let (h, rest) = (cell / (nb * pb), cell % (nb * pb));
         let (k, b) = (rest / pb, rest % pb);
-        let mu = self.edges[k] + u[0] * (self.edges[k + 1] - self.edges[k]);
-        let phi = sign * (b as f64 + u[1]) * PI / pb as f64;
+        let mu = (k as f64 + u[0]) / nb as f64;
+        // Within the cell the density is linear in |phi| from `a` to `c`:
+        // invert its cumulative `(a x + (c - a) x^2 / 2) / ((a + c) / 2)`.
+        let e = (h * nb + k) * (pb + 1) + b;
+        let (a, c) = (cd.edge[e], cd.edge[e + 1]);
+        let x = if (c - a).abs() <= 1e-9 * (a + c) {
+            u[1]
+        } else {
+            (((a * a * (1.0 - u[1]) + c * c * u[1]).sqrt() - a) / (c - a)).clamp(0.0, 1.0)
+        };
+        let phi = sign * (b as f64 + x) * PI / pb as f64;
         let s = (1.0 - mu * mu).max(0.0).sqrt();
         // wo's azimuth (reference +x at normal), then pi + phi from it.
         let so = (wo.x * wo.x + wo.y * wo.y).sqrt();

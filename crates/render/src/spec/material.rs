@@ -98,6 +98,24 @@ pub struct PaperSpec {
     /// Ink map.
     #[serde(skip_serializing)]
     pub ink_map: Option<InkMapSpec>,
+    /// The model that renders the sheet: `"paper"` (default) or `"slab"`.
+    #[serde(skip_serializing)]
+    pub model: Option<SheetModel>,
+}
+
+/// The model of a `type = "paper"` material (docs/design.md 4.7).
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum SheetModel {
+    /// The Paper BSDF (`paperbsdf_core::PaperBsdf`): closed forms, built in
+    /// about 0.1 ms.
+    #[default]
+    Paper,
+    /// The same sheet solved by adding-doubling (`paperbsdf_slab::SlabBsdf`):
+    /// accurate for thin and weakly scattering sheets too, built in about
+    /// 0.5 to 1 s per parameter set (each level of a thickness or ink map is
+    /// one).
+    Slab,
 }
 
 /// `type = "measured"`: a measured RGL BRDF.

@@ -3,7 +3,7 @@
 //! parameter and measured files) read, materials and shapes built. Each error
 //! names the scene file and the entry.
 
-use super::material::{MaterialSpec, PaperSpec};
+use super::material::{MaterialSpec, PaperSpec, SheetModel};
 use super::schema::{ColourSpec, RenderSpec, SceneSpec, ShapeSpec, TransformSpec};
 use super::Resources;
 use crate::error::SceneError;
@@ -270,7 +270,11 @@ fn material(name: &str, m: &MaterialSpec, file: &str, res: &Resources) -> Result
                     })
                 }
             };
-            let pm = PaperMaterial::new(p, thickness, ink, paper_model::paper_bsdf).map_err(|e| at.err(e))?;
+            let factory: crate::material::PaperFactory = match m.model.unwrap_or_default() {
+                SheetModel::Paper => paper_model::paper_bsdf,
+                SheetModel::Slab => paper_model::slab_bsdf,
+            };
+            let pm = PaperMaterial::new(p, thickness, ink, factory).map_err(|e| at.err(e))?;
             Material::Paper(Box::new(pm))
         }
         MaterialSpec::Measured(m) => {
