@@ -67,6 +67,7 @@ def cli_eval(cli, model, params_arg, wi, wo, tmp_path):
     ("reduced-multilayer", UNEQUAL),
     ("lambert-glass", {"k_d": 0.3, "k_t": 0.2, "eta": 1.5, "m": 0.2, "dist": "ggx"}),
     ("rough-dielectric", {"eta": 1.33, "m": 0.3, "dist": "beckmann"}),
+    ("slab", "luster"),
 ])
 def test_eval_matches_cli(cli, tmp_path, model, params):
     wi, wo = hard_pairs()

@@ -1,0 +1,64 @@
+//! Speed of the model `slab` (issue 13's targets: one build <= 1 s for
+//! paper-like sheets, eval <= 200 ns, sample <= 300 ns): eval in reflection
+//! and transmission, pdf, sample, at directions off the nodes, and the build
+//! (`SlabBsdf::new`: the faces' projection, one adding-doubling solve per
+//! distinct colour channel and one without scattering, the tables and the
+//! sampling densities) for matte (RGB absorption: three channels) and
+//! luster (two distinct faces, one channel).
+//! Run with `cargo bench -p paperbsdf-slab --bench slab`.
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use paperbsdf_core::presets;
+use paperbsdf_core::{Bsdf, DVec3};
+use paperbsdf_slab::SlabBsdf;
+
+fn bench(c: &mut Criterion) {
+    for name in ["matte", "luster"] {
+        let p = presets::preset(name).unwrap();
+        let b = SlabBsdf::new(&p).unwrap();
+        let wo = DVec3::new(0.3, 0.1, 0.9).normalize();
+        let wi_r = DVec3::new(-0.4, 0.2, 0.8).normalize();
+        let wi_t = DVec3::new(-0.4, 0.2, -0.8).normalize();
+        // Directions through an opaque reference (see core's benches/paper.rs).
+        let (dr, dt) = ((wi_r, wo), (wi_t, wo));
+        c.bench_function(&format!("slab/{name}/eval_reflection"), |bn| {
+            bn.iter(|| {
+                let d = black_box(&dr);
+                black_box(&b).eval(d.0, d.1)
+            })
+        });
+        c.bench_function(&format!("slab/{name}/eval_transmission"), |bn| {
+            bn.iter(|| {
+                let d = black_box(&dt);
+                black_box(&b).eval(d.0, d.1)
+            })
+        });
+        c.bench_function(&format!("slab/{name}/pdf"), |bn| {
+            bn.iter(|| {
+                let d = black_box(&dr);
+                black_box(&b).pdf(d.0, d.1)
+            })
+        });
+        let mut k = 0u64;
+        c.bench_function(&format!("slab/{name}/sample"), |bn| {
+            bn.iter(|| {
+                k = k.wrapping_add(0x9E37_79B9_7F4A_7C15);
+                let u = [
+                    (k >> 11) as f64 / (1u64 << 53) as f64,
+                    ((k.wrapping_mul(3)) >> 11) as f64 / (1u64 << 53) as f64,
+                    ((k.wrapping_mul(7)) >> 11) as f64 / (1u64 << 53) as f64,
+                ];
+                black_box(&b).sample(black_box(wo), u[0], [u[1], u[2]])
+            })
+        });
+    }
+    let mut g = c.benchmark_group("slab_build");
+    g.sample_size(10);
+    for name in ["matte", "luster"] {
+        let p = presets::preset(name).unwrap();
+        g.bench_function(name, |bn| bn.iter(|| SlabBsdf::new(black_box(&p)).unwrap()));
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
