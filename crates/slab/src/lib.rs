@@ -53,7 +53,7 @@ pub mod slab;
 
 pub use bsdf::{SlabBsdf, SlabOptions};
 pub use error::SlabError;
-pub use interface::{face_interface, Compensation, ProjectedFace, Projection};
+pub use interface::{face_interface, smooth_boundary, Compensation, ProjectedFace, Projection};
 pub use layer::{Layer, SymmetricLayer};
 pub use quad::Grid;
-pub use slab::{Discretisation, Face, Medium, Prepared, Side, SlabSpec, Solution};
+pub use slab::{Coating, Discretisation, Face, Medium, Prepared, Side, SlabSpec, Solution};
