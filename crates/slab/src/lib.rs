@@ -15,33 +15,45 @@
 //!
 //! **What exists.** Gauss-Radau / split Gauss-Legendre grids; HG Fourier
 //! coefficients with symmetric normalisation; the diamond starting layer and
-//! doubling; adding of general (unequal-grid) layers; faces of equal index:
-//! smooth Fresnel faces, index-matched faces, and rough faces of either
-//! distribution (GGX, Beckmann) projected from core's Walter et al. rough
-//! dielectric onto the grids and Fourier orders ([`interface`]: a graded
-//! Gauss-Legendre rule in azimuth, symmetric normalisation to core's
-//! directional albedo) with, for `face_scattering = "multiple"`, core's
-//! separable energy compensation; [`SlabSpec::from_params`] for the physical
-//! sheet of a `PaperParams` (one colour channel); totals for collimated light
-//! at a node and for diffuse light, from either side; the BSDF between nodes.
-//! Measured (tests/): reciprocity to 2e-14 in every order, `R + T = 1` to
-//! 1e-10 for conservative sheets with `"multiple"` faces, totals of rough
-//! sheets within 2e-3 of the simulator (tau 2 and 30, 0 to 75 degrees, both
-//! face modes), 32 nodes within 6e-4 of 64.
+//! doubling; adding of general (unequal-grid) layers; smooth Fresnel faces,
+//! index-matched faces, and rough faces of either distribution (GGX,
+//! Beckmann) projected from core's Walter et al. rough dielectric onto the
+//! grids and Fourier orders ([`interface`]: a graded Gauss-Legendre rule in
+//! azimuth, symmetric normalisation to core's directional albedo) with, for
+//! `face_scattering = "multiple"`, core's separable energy compensation;
+//! faces of unequal index, i.e. the coated sheet of docs/design.md 4.1
+//! (`eta_f != eta_b`: the rough air/coating front over a coating of zero
+//! thickness and the smooth coating/base boundary, [`slab`]), on a coating
+//! grid and a medium grid that keep the boundary diagonal ([`quad`],
+//! [`Grid::denser`]; [`interface::smooth_boundary`]);
+//! [`SlabSpec::from_params`] for the physical sheet of a `PaperParams` (one
+//! colour channel); totals for collimated light at a node and for diffuse
+//! light, from either side; the BSDF between nodes; the model `slab` as a
+//! BSDF ([`bsdf`]). Measured (tests/): reciprocity to 2e-14 in every order,
+//! `R + T = 1` to 1e-10 for conservative sheets with `"multiple"` faces
+//! (coated ones to 8e-10), totals of rough sheets within 2e-3 of the
+//! simulator (tau 2 and 30, 0 to 75 degrees, both face modes; coated sheets
+//! with `eta_f` 1.55 over `eta_b` 1.45 and the reverse, from either side,
+//! within 2.7e-3, tests/coated.rs), 32
+//! nodes within 6e-4 of 64; a smooth coated sheet without scattering equals
+//! its closed form (Fresnel factors with the coating's interreflections
+//! summed) to 4e-14.
 //!
-//! **What is missing for issue 13.** Faces of unequal index (the coated
-//! sheet of docs/design.md 4.1: its smooth coating/base boundary under the
-//! rough front, as `core::sheet` and the simulator have it); lobes narrower
-//! than the grid (roughness below about 0.1, e.g. the glossy preset's
-//! m_f = 0.04, needs more nodes or an analytic treatment of the lit face's
-//! reflection); the analytic parts (surface reflection of the lit face,
-//! unscattered transmission, exact single scattering) with the orders that
-//! carry first scattering subtracted; interpolation of the matrices to
-//! arbitrary directions (incidence off the nodes) and the BSDF's eval and
-//! sample; RGB channels in one solve; the model registry and CLI; the speed
+//! **What is missing for issue 13.** Lobes narrower than the grid
+//! (roughness below about 0.1, e.g. the glossy preset's m_f = 0.04: its
+//! projection is normalised to core's albedo, but the lobe is not resolved
+//! by 32 nodes) and, for the coated front, [`bsdf`]'s analytic lit face
+//! (core's coated face includes a separable lobe for the light the coating's
+//! boundary sends back out, which the solution holds already, and its delta
+//! lobes of two smooth faces assume one index); further analytic parts
+//! (unscattered transmission through rough faces, exact single scattering)
+//! with the orders that carry them subtracted; RGB channels in one solve; the speed
 //! targets (a solve with two distinct rough faces takes 0.6 s at 32 nodes,
 //! mostly the faces' projection and normalisation); the 2% accuracy of the
 //! BSDF values themselves (only totals are checked against the simulator).
+//! Near `eta_f = eta_b` from below (the base denser) the discretisation
+//! moves with the boundary's critical cosine, by `O(sqrt(eta_b - eta_f))`
+//! (8e-5 in the totals at a difference of 1e-6; tests/coated.rs).
 
 pub mod bsdf;
 pub mod error;

@@ -115,7 +115,9 @@ impl Face {
     }
 }
 
-/// The sheet to solve: a medium between a front face (top, `+z`) and a back face.
+/// The sheet to solve: a medium between a front face (top, `+z`) and a back
+/// face; when their indices differ the front face is over a coating of its
+/// index (module doc), the medium has the back face's index.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SlabSpec {
     /// The medium.
