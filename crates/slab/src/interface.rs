@@ -19,6 +19,16 @@
 //! With the reciprocity weights `w mu / eta^2` these matrices satisfy the
 //! reciprocity relations of [`crate::layer`] exactly.
 //!
+//! **Smooth boundary between two media** ([`smooth_boundary`]): the same with
+//! the less dense medium in the place of air and the relative index
+//! `r = n_lower / n_upper` (above or below 1), e.g. a coated sheet's
+//! coating/base boundary `eta_b / eta_f` (`paperbsdf_core::sheet`): pairs of
+//! nodes that are each other's Snell images (grids of [`Grid::denser`]),
+//! `F` of the pair, `T = r^2 (1 - F)` downward and `(1 - F) / r^2` upward,
+//! total reflection of the denser side's nodes beyond the critical angle.
+//! The reciprocity weights `w mu / n^2` of the two grids (absolute indices)
+//! make it reciprocal exactly, since `w' mu' = w mu / r^2` on paired nodes.
+//!
 //! **Rough interface** (`face_scattering = "single"`): the BSDF is core's
 //! Walter et al. (EGSR 2007) rough dielectric,
 //! [`RoughDielectric::eval_mode`] in [`TransportMode::Radiance`], whose
@@ -104,7 +114,7 @@ use crate::quad::Grid;
 use nalgebra::DMatrix;
 use paperbsdf_core::boundary::{dir_at_mu, directional_albedo_n};
 use paperbsdf_core::dielectric::Interface;
-use paperbsdf_core::fresnel::fresnel_dielectric;
+use paperbsdf_core::fresnel::{cos_transmitted, fresnel_dielectric};
 use paperbsdf_core::microsurface_tables::compensation_shares;
 use paperbsdf_core::quadrature::gauss_legendre_01;
 use paperbsdf_core::{DVec3, FaceScattering, RoughDielectric, TransportMode};
@@ -113,31 +123,89 @@ use std::f64::consts::PI;
 
 /// The smooth interface from the `outside` grid (air) to the `inside` grid
 /// made from it by [`Grid::inside`] (module doc). Index-matched (`eta = 1`):
-/// the identity.
+/// the identity. The pairing of the nodes is not checked here
+/// ([`smooth_boundary`] checks it).
 pub fn smooth_interface(outside: &Grid, inside: &Grid) -> Layer {
-    let (no, ni) = (outside.len(), inside.len());
-    let eta = inside.eta;
-    if eta == 1.0 {
-        return Layer::identity(no);
+    if inside.eta == 1.0 {
+        return Layer::identity(outside.len());
     }
-    let e2 = eta * eta;
-    let off = ni - no;
-    let mut r_top = DMatrix::zeros(no, no);
-    let mut t_down = DMatrix::zeros(ni, no);
-    let mut t_up = DMatrix::zeros(no, ni);
-    let mut r_bot = DMatrix::identity(ni, ni);
-    for k in 0..no {
-        let f = fresnel_dielectric(outside.mu[k], eta);
-        r_top[(k, k)] = f;
-        t_down[(off + k, k)] = e2 * (1.0 - f);
-        t_up[(k, off + k)] = (1.0 - f) / e2;
-        r_bot[(off + k, off + k)] = f;
+    paired_boundary(outside, inside, true)
+}
+
+/// The smooth boundary between the medium of grid `upper` (top side) and
+/// the medium of grid `lower` (bottom side), of relative index
+/// `r = lower.eta / upper.eta` (either way: the coating/base boundary of a
+/// coated sheet is `eta_b / eta_f`, below or above 1). As
+/// [`smooth_interface`] (module doc) with the less dense medium in the place
+/// of air: Fresnel's `F` of the pair, transmission `r^2 (1 - F)` downward and
+/// `(1 - F) / r^2` upward (radiance scales with the square of the index), the
+/// denser side's nodes without an image reflected totally. The denser grid
+/// must pair every node of the other with its Snell image, as
+/// [`Grid::denser`] makes it: its last nodes are those images, checked to
+/// `1e-12`; otherwise [`SlabError::Unsupported`] (a smooth boundary is a
+/// diagonal map only on such grids). Equal indices: the identity (the grids
+/// must be equal).
+pub fn smooth_boundary(upper: &Grid, lower: &Grid) -> Result<Layer, SlabError> {
+    const NOT_PAIRED: &str = "a smooth boundary between grids that do not pair every node of the less dense \
+         medium with its Snell image in the denser one (make the denser grid with Grid::denser)";
+    if upper.eta == lower.eta {
+        return if upper == lower {
+            Ok(Layer::identity(upper.len()))
+        } else {
+            Err(SlabError::Unsupported(NOT_PAIRED))
+        };
     }
-    Layer {
-        r_top,
-        t_down,
-        r_bot,
-        t_up,
+    let less_on_top = lower.eta > upper.eta;
+    let (less, dense) = if less_on_top { (upper, lower) } else { (lower, upper) };
+    if dense.len() < less.len() {
+        return Err(SlabError::Unsupported(NOT_PAIRED));
+    }
+    let r = dense.eta / less.eta;
+    let off = dense.len() - less.len();
+    for k in 0..less.len() {
+        let image = cos_transmitted(less.mu[k], r).map_or(f64::NAN, f64::abs);
+        // (NaN, a node of total reflection, fails too)
+        if (image - dense.mu[off + k]).abs().is_nan() || (image - dense.mu[off + k]).abs() > 1e-12 {
+            return Err(SlabError::Unsupported(NOT_PAIRED));
+        }
+    }
+    Ok(paired_boundary(upper, lower, less_on_top))
+}
+
+/// The smooth boundary's layer on grids paired as [`Grid::denser`] pairs
+/// them (unchecked), the less dense medium on top if `less_on_top`.
+fn paired_boundary(upper: &Grid, lower: &Grid, less_on_top: bool) -> Layer {
+    let (less, dense) = if less_on_top { (upper, lower) } else { (lower, upper) };
+    let (nl, nd) = (less.len(), dense.len());
+    let r = dense.eta / less.eta;
+    let r2 = r * r;
+    let off = nd - nl;
+    // The blocks seen from the less dense side (l) and the denser side (d).
+    let mut r_l = DMatrix::zeros(nl, nl);
+    let mut r_d = DMatrix::identity(nd, nd);
+    let mut t_ld = DMatrix::zeros(nd, nl);
+    let mut t_dl = DMatrix::zeros(nl, nd);
+    for k in 0..nl {
+        let f = fresnel_dielectric(less.mu[k], r);
+        r_l[(k, k)] = f;
+        t_ld[(off + k, k)] = r2 * (1.0 - f);
+        t_dl[(k, off + k)] = (1.0 - f) / r2;
+        r_d[(off + k, off + k)] = f;
+    }
+    if less_on_top {
+        Layer {
+            r_top: r_l,
+            t_down: t_ld,
+            r_bot: r_d,
+            t_up: t_dl,
+        }
+    } else {
+        Layer {
+            r_top: r_d,
+            t_down: t_dl,
+            r_bot: r_l,
+            t_up: t_ld,
+        }
     }
 }
 
@@ -255,9 +323,11 @@ pub struct Projection {
 }
 
 /// The face `bd` (air above, medium of index `bd.eta` below) on the grids
-/// `outside` and `inside` (made by [`Grid::inside`] with `bd.eta`):
-/// index-matched faces are the identity, smooth ones [`smooth_interface`] in
-/// every order, rough ones the projection of `RoughDielectric::eval_mode`
+/// `outside` (air) and `inside` (index `bd.eta`): index-matched faces are the
+/// identity (the grids must be equal), smooth ones [`smooth_boundary`] in
+/// every order (`inside` must pair the outside nodes with their Snell images
+/// as [`Grid::inside`] and [`Grid::denser`] make it, else
+/// [`SlabError::Unsupported`]); rough ones, on any grids of those indices, the projection of `RoughDielectric::eval_mode`
 /// (radiance transport) as `proj` says, plus the compensation when
 /// `scattering` is [`FaceScattering::Multiple`] (module doc).
 pub fn face_interface(
@@ -290,8 +360,15 @@ pub fn face_interface(
         scale: vec![1.0; outside.len() + inside.len()],
     };
     match bd.interface {
-        Interface::IndexMatched => Ok(single(Layer::identity(outside.len()))),
-        Interface::Smooth => Ok(single(smooth_interface(outside, inside))),
+        Interface::IndexMatched => {
+            if outside != inside {
+                return Err(SlabError::Unsupported(
+                    "an index-matched face between two different grids (they must be the same grid)",
+                ));
+            }
+            Ok(single(Layer::identity(outside.len())))
+        }
+        Interface::Smooth => Ok(single(smooth_boundary(outside, inside)?)),
         Interface::Rough(_) => {
             check_azimuth_points(azimuth_points)?;
             let mut orders_l = walter_projection(bd, outside, inside, orders, azimuth_points);

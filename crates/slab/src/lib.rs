@@ -15,40 +15,52 @@
 //!
 //! **What exists.** Gauss-Radau / split Gauss-Legendre grids; HG Fourier
 //! coefficients with symmetric normalisation; the diamond starting layer and
-//! doubling; adding of general (unequal-grid) layers; faces of equal index:
-//! smooth Fresnel faces, index-matched faces, and rough faces of either
-//! distribution (GGX, Beckmann) projected from core's Walter et al. rough
-//! dielectric onto the grids and Fourier orders ([`interface`]: a graded
-//! Gauss-Legendre rule in azimuth, symmetric normalisation to core's
-//! directional albedo) with, for `face_scattering = "multiple"`, core's
-//! separable energy compensation; [`SlabSpec::from_params`] for the physical
-//! sheet of a `PaperParams` (one colour channel), [`SlabSpec::prepare`] for
-//! the part of a solve shared by the channels; totals for collimated light
-//! at a node and for diffuse light, from either side; the BSDF between
-//! nodes. **The model `slab`** ([`bsdf::SlabBsdf`], in core's registry as
-//! `ModelKind::Slab`, built by `paperbsdf_io`): the lit face's reflection
-//! analytic (core's face), the delta lobes of smooth sheets in closed form,
-//! the rest interpolated from the Fourier tables; `eval`, `sample`, `pdf`
-//! (chi-square tested), components.
+//! doubling; adding of general (unequal-grid) layers; smooth Fresnel faces,
+//! index-matched faces, and rough faces of either distribution (GGX,
+//! Beckmann) projected from core's Walter et al. rough dielectric onto the
+//! grids and Fourier orders ([`interface`]: a graded Gauss-Legendre rule in
+//! azimuth, symmetric normalisation to core's directional albedo) with, for
+//! `face_scattering = "multiple"`, core's separable energy compensation;
+//! faces of unequal index, i.e. the coated sheet of docs/design.md 4.1
+//! (`eta_f != eta_b`: the rough air/coating front over a coating of zero
+//! thickness and the smooth coating/base boundary, [`slab`]), on a coating
+//! grid and a medium grid that keep the boundary diagonal ([`quad`],
+//! [`Grid::denser`]; [`interface::smooth_boundary`]);
+//! [`SlabSpec::from_params`] for the physical sheet of a `PaperParams` (one
+//! colour channel), [`SlabSpec::prepare`] for the part of a solve shared by
+//! the channels; totals for collimated light at a node and for diffuse
+//! light, from either side; the BSDF between nodes. **The model `slab`**
+//! ([`bsdf::SlabBsdf`], in core's registry as `ModelKind::Slab`, built by
+//! `paperbsdf_io`): the lit face's reflection analytic (core's face), the
+//! delta lobes of smooth sheets in closed form, the rest interpolated from
+//! the Fourier tables; `eval`, `sample`, `pdf` (chi-square tested),
+//! components.
+//!
 //! Measured (tests/): reciprocity to 2e-14 in every order (and of the
 //! interpolated BSDF), `R + T = 1` to 1e-10 for conservative sheets with
-//! `"multiple"` faces (the BSDF with its analytic face: 1.4e-3), totals of
-//! rough sheets within 2e-3 of the simulator (tau 2 and 30, 0 to 75
-//! degrees, both face modes), index-matched sheets within 2e-4 of
-//! PythonicDISORT, smooth faces within 0.5% of iadpython, 32 nodes within
-//! 6e-4 of 64; BSDF values against the simulator: docs/accuracy_slab.md.
+//! `"multiple"` faces (coated ones to 8e-10; the BSDF with its analytic
+//! face: 1.4e-3), totals of rough sheets within 2e-3 of the simulator (tau 2
+//! and 30, 0 to 75 degrees, both face modes; coated sheets with `eta_f` 1.55
+//! over `eta_b` 1.45 and the reverse, from either side, within 2.7e-3,
+//! tests/coated.rs), index-matched sheets within 2e-4 of PythonicDISORT,
+//! smooth faces within 0.5% of iadpython, 32 nodes within 6e-4 of 64; a
+//! smooth coated sheet without scattering equals its closed form (Fresnel
+//! factors with the coating's interreflections summed) to 4e-14; BSDF values
+//! against the simulator: docs/accuracy_slab.md.
 //!
-//! **What is missing for issue 13.** Faces of unequal index (the coated
-//! sheet of docs/design.md 4.1: its smooth coating/base boundary under the
-//! rough front, as `core::sheet` and the simulator have it); lobes narrower
-//! than the grid (roughness below about 0.1, e.g. the glossy preset's
-//! m_f = 0.04: the face's own reflection is analytic, but the light it lets
-//! in and out is projected on the grid); exact single scattering as its own
-//! analytic term (the tables hold every scattering order, so `slab` has no
-//! separate `single` component); the R/T split of the projected faces
-//! (normalised on R + T, the split 1e-3 off, which is the BSDF's energy
-//! error once the lit face's reflection is analytic); the build-time target
-//! (about 0.5 to 1.3 s for the presets).
+//! **What is missing for issue 13.** Lobes narrower than the grid
+//! (roughness below about 0.1, e.g. the glossy preset's m_f = 0.04: the
+//! face's own reflection is analytic, but the light it lets in and out is
+//! projected on 32 nodes, which do not resolve it); further analytic parts
+//! (unscattered transmission through rough faces, exact single scattering
+//! as its own term: the tables hold every scattering order, so `slab` has
+//! no separate `single` component); the R/T split of the projected faces
+//! (normalised on R + T, the split 1e-3 off, which becomes the BSDF's
+//! energy error once the lit face's reflection is analytic); the build-time
+//! target (about 0.5 to 1.3 s for the presets). Near `eta_f = eta_b` from
+//! below (the base denser) the discretisation moves with the boundary's
+//! critical cosine, by `O(sqrt(eta_b - eta_f))` (8e-5 in the totals at a
+//! difference of 1e-6; tests/coated.rs).
 
 pub mod bsdf;
 pub mod error;
@@ -60,7 +72,7 @@ pub mod slab;
 
 pub use bsdf::{SlabBsdf, SlabOptions};
 pub use error::SlabError;
-pub use interface::{face_interface, Compensation, ProjectedFace, Projection};
+pub use interface::{face_interface, smooth_boundary, Compensation, ProjectedFace, Projection};
 pub use layer::{Layer, SymmetricLayer};
 pub use quad::Grid;
-pub use slab::{Discretisation, Face, Medium, Prepared, Side, SlabSpec, Solution};
+pub use slab::{Coating, Discretisation, Face, Medium, Prepared, Side, SlabSpec, Solution};

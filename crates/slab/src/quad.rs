@@ -17,6 +17,19 @@
 //! on both sides of it. This is the split of Prahl's adding-doubling
 //! (Prahl, van Gemert, Welch 1993) and of Jakob et al. 2014 (section 6.1), here
 //! with Radau outside; the nodes and weights are computed here, not copied.
+//!
+//! **A coated sheet** (front coating of index `eta_f` over a base of index
+//! `eta_b != eta_f`, `paperbsdf_core::sheet`) has three grids: the outside
+//! grid, the coating's and the base's. The smooth coating/base boundary is
+//! resolved as the air/medium one: the less dense of the two media gets
+//! [`Grid::inside`] of the outside grid, the denser one [`Grid::denser`] of
+//! that, i.e. the Snell images of all its nodes plus a Gauss-Legendre rule in
+//! its cone of total internal reflection at the boundary
+//! (`mu < sqrt(1 - (n_less / n_denser)^2)`). Since the Snell invariant
+//! `n sin theta` is what refraction keeps, the last nodes of both inside
+//! grids are the images of the outside nodes, so any smooth face between air
+//! and either medium is diagonal too, and the panels of the three grids meet
+//! at the two kinks (`n sin theta = 1` and `= min(eta_f, eta_b)`).
 
 use nalgebra::{DMatrix, SymmetricEigen};
 use paperbsdf_core::boundary::critical_mu;
@@ -66,19 +79,37 @@ impl Grid {
     /// outside grid itself. `outside` must be in air (`eta = 1`).
     pub fn inside(outside: &Grid, eta: f64, n_tir: usize) -> Grid {
         debug_assert_eq!(outside.eta, 1.0);
-        if eta == 1.0 {
-            return outside.clone();
+        Grid::denser(outside, eta, n_tir)
+    }
+    /// The grid in a medium of (absolute) index `eta >= from.eta` beyond a
+    /// smooth boundary with the medium of `from` (relative index
+    /// `r = eta / from.eta`): `n_tir` Gauss-Legendre nodes on `[0, mu_c]`,
+    /// `mu_c = sqrt(1 - 1/r^2)` (the directions that the boundary reflects
+    /// totally back into the denser medium), then the Snell images of all of
+    /// `from`'s nodes in the same order, with the weights of the change of
+    /// variables `mu' dmu' = mu dmu / r^2` (module doc). So the boundary is
+    /// diagonal between the two grids, and the last `from.len()` nodes are the
+    /// images of `from`'s (images of images are images: the Snell invariant
+    /// `n sin theta` is kept). For `eta = from.eta` it is `from` itself.
+    ///
+    /// The coated sheet's grids (`crate::slab`) are made with it: the
+    /// coating's and the base's from the outside grid, the less dense first.
+    pub fn denser(from: &Grid, eta: f64, n_tir: usize) -> Grid {
+        debug_assert!(eta >= from.eta, "Grid::denser: {eta} < {}", from.eta);
+        if eta == from.eta {
+            return from.clone();
         }
-        let e2 = eta * eta;
-        let mu_c = critical_mu(eta);
+        let r = eta / from.eta;
+        let r2 = r * r;
+        let mu_c = critical_mu(r);
         let (x, wx) = gauss_legendre_01(n_tir);
         let mut mu: Vec<f64> = x.iter().map(|x| x * mu_c).collect();
         let mut w: Vec<f64> = wx.iter().map(|w| w * mu_c).collect();
-        for (mo, wo) in outside.mu.iter().zip(&outside.w) {
-            // Outside to inside (eta > 1) never meets total internal reflection.
-            let mi = cos_transmitted(*mo, eta).map_or(0.0, f64::abs);
+        for (mo, wo) in from.mu.iter().zip(&from.w) {
+            // Into the denser medium there is no total internal reflection.
+            let mi = cos_transmitted(*mo, r).map_or(0.0, f64::abs);
             mu.push(mi);
-            w.push(wo * mo / (e2 * mi));
+            w.push(wo * mo / (r2 * mi));
         }
         Grid { mu, w, eta }
     }
@@ -180,6 +211,38 @@ mod tests {
         // the two-point rule: nodes 1/3 and 1 on [0, 1], weights 3/4 and 1/4
         let (x, w) = gauss_radau_01(2);
         assert!((x[0] - 1.0 / 3.0).abs() < 1e-15 && (w[0] - 0.75).abs() < 1e-15);
+    }
+
+    #[test]
+    fn denser_grids_pair_snell_images_and_integrate() {
+        let out = Grid::outside(12);
+        for (n1, n2) in [(1.3, 1.6), (1.5, 1.55), (1.45, 1.55), (1.0, 1.5)] {
+            let a = Grid::inside(&out, n1, 8);
+            let b = Grid::denser(&a, n2, 6);
+            assert_eq!((b.len(), b.eta), (a.len() + 6, n2));
+            let s1: f64 = b.mu.iter().zip(&b.w).map(|(m, w)| w * m).sum();
+            let s3: f64 = b.mu.iter().zip(&b.w).map(|(m, w)| w * m.powi(3)).sum();
+            assert!(
+                (s1 - 0.5).abs() < 1e-13 && (s3 - 0.25).abs() < 1e-13,
+                "{n1} {n2}: {s1} {s3}"
+            );
+            assert!(b.mu.windows(2).all(|p| p[0] < p[1]) && b.mu[0] > 0.0);
+            // the images of a's nodes, and (images of images) those of the outside nodes
+            let off = b.len() - a.len();
+            for k in 0..a.len() {
+                let img = cos_transmitted(a.mu[k], n2 / n1).unwrap().abs();
+                assert!((b.mu[off + k] - img).abs() < 1e-15);
+                assert!((b.w[off + k] * b.mu[off + k] - a.w[k] * a.mu[k] * (n1 * n1) / (n2 * n2)).abs() < 1e-15);
+            }
+            let off = b.len() - out.len();
+            for k in 0..out.len() {
+                let img = cos_transmitted(out.mu[k], n2).unwrap().abs();
+                assert!((b.mu[off + k] - img).abs() < 1e-13, "{n1} {n2} {k}");
+            }
+            // the cone of total reflection at the boundary has exactly its own nodes
+            let mu_c = critical_mu(n2 / n1);
+            assert_eq!(b.mu.iter().filter(|m| **m < mu_c).count(), 6);
+        }
     }
 
     #[test]

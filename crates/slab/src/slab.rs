@@ -1,9 +1,39 @@
 //! The sheet as a stack: front face, medium, back face, per Fourier order
-//! (the physical sheet of `paperbsdf_core::sheet` with air on both sides and
-//! faces of one index).
+//! (the physical sheet of `paperbsdf_core::sheet`, air on both sides).
+//!
+//! **Faces of one index** (`eta_f = eta_b`): two grids, the outside grid
+//! (air) and the medium's ([`Grid::inside`]); the sheet is
+//! `front + medium + back flipped` (adding, [`crate::layer`]), both faces
+//! projected between the outside grid and the medium's.
+//!
+//! **A coated front** (`eta_f != eta_b`): air | rough front interface
+//! (air/coating, index `eta_f`) | a coating of zero thickness that neither
+//! scatters nor absorbs | the smooth coating/base boundary (relative index
+//! `eta_b / eta_f`) | the medium (the base, index `eta_b`) | the rough back
+//! interface (base/air, index `eta_b`), as `paperbsdf_core::sheet` and the
+//! simulator (`paperbsdf_sim`'s faces) have it. Three grids
+//! ([`crate::quad`]): the outside grid, the coating's and the medium's; the
+//! less dense of the two media gets [`Grid::inside`] of the outside grid and
+//! the denser [`Grid::denser`] of that, so the boundary is diagonal
+//! ([`crate::interface::smooth_boundary`]: Fresnel of the pair, the `n^2`
+//! scaling of radiance, total reflection of the denser side's directions
+//! beyond its critical angle) and the back face (and a smooth front) can be
+//! projected between the outside grid and either inside grid. The front face
+//! is projected between the outside grid and the coating's, the back face
+//! between the outside grid and the medium's. The coating has no thickness,
+//! so the front face and the boundary are simply added: the adding formula's
+//! `(I - R_front,bot R_boundary,top)^-1` sums the interreflections inside the
+//! coating. That coated front ([`Coating::front`]) depends on neither albedo
+//! nor thickness, so [`SlabSpec::prepare`] adds it once; per order the sheet
+//! is `coated front + medium + back flipped`. [`Prepared::faces`] keep the
+//! bare faces: the front's `r_top` is the rough air/coating interface's
+//! reflection from outside alone (what `crate::bsdf` replaces by the
+//! analytic face), the boundary's contribution is in [`Prepared::coating`].
 
 use crate::error::SlabError;
-use crate::interface::{face_interface, Compensation, ProjectedFace, Projection, DEFAULT_AZIMUTH_POINTS};
+use crate::interface::{
+    face_interface, smooth_boundary, Compensation, ProjectedFace, Projection, DEFAULT_AZIMUTH_POINTS,
+};
 use crate::layer::{default_start_thickness, medium_layer, Layer};
 use crate::phase::{phase_fourier, validate, PhaseFourier};
 use crate::quad::Grid;
@@ -29,7 +59,7 @@ pub enum Face {
     /// A smooth Fresnel interface to air of relative index `eta` in `[1, 5]`
     /// (1: no interface).
     Smooth {
-        /// Relative index (medium over air).
+        /// Relative index (the medium, or a front's coating, over air).
         eta: f64,
     },
     /// A rough interface (core's [`RoughDielectric`]): relative index `eta`
@@ -38,7 +68,7 @@ pub enum Face {
     /// `dist`, scattering once among its microfacets (Walter et al. 2007) or
     /// with core's energy compensation (`scattering`; [`crate::interface`]).
     Rough {
-        /// Relative index (medium over air).
+        /// Relative index (the medium, or a front's coating, over air).
         eta: f64,
         /// Microfacet roughness (alpha).
         m: f64,
@@ -85,7 +115,9 @@ impl Face {
     }
 }
 
-/// The sheet to solve: a medium between a front face (top, `+z`) and a back face.
+/// The sheet to solve: a medium between a front face (top, `+z`) and a back
+/// face; when their indices differ the front face is over a coating of its
+/// index (module doc), the medium has the back face's index.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SlabSpec {
     /// The medium.
@@ -102,8 +134,11 @@ pub struct Discretisation {
     /// Gauss-Radau nodes per hemisphere outside (air), at least 2; the inside
     /// grid has as many in the cone that refracts out ([`crate::quad`]).
     pub nodes: usize,
-    /// Gauss-Legendre nodes in the cone of total internal reflection (used
-    /// when the medium's index exceeds 1), at least 1.
+    /// Gauss-Legendre nodes in each cone of total internal reflection, at
+    /// least 1: the inside grid's cone beyond the air's critical angle (when
+    /// the medium's index exceeds 1) and, for a coated sheet, the denser
+    /// medium's cone beyond the coating/base boundary's critical angle
+    /// ([`Grid::denser`]).
     pub tir_nodes: usize,
     /// Fourier orders `0..orders` in azimuth, at least 1 (totals need only order 0).
     pub orders: usize,
@@ -146,8 +181,10 @@ pub enum Side {
 pub struct Solution {
     /// The grid in air on either side of the sheet.
     pub outside: Grid,
-    /// The grid inside the medium.
+    /// The grid inside the medium (the base: index `eta_b`).
     pub inside: Grid,
+    /// The coating's grid (index `eta_f`) of a coated sheet (`eta_f != eta_b`), `None` otherwise.
+    pub coating: Option<Grid>,
     /// The sheet's layer per Fourier order.
     pub orders: Vec<Layer>,
     /// The medium layer alone for each order (inside grid).
@@ -164,8 +201,9 @@ impl SlabSpec {
     /// The sheet of `p` (docs/design.md 3; `paperbsdf_core::sheet`) in colour
     /// channel `channel` (0 to 2; a scalar parameter is the same in every
     /// channel): albedo `sigma_s / sigma_t` (0 when `sigma_t = 0`),
-    /// `tau = sigma_t d`, rough faces as [`Face::of_sheet`]. Faces of unequal
-    /// index are [`SlabError::Unsupported`].
+    /// `tau = sigma_t d`, rough faces as [`Face::of_sheet`] (the front face
+    /// has index `eta_f`, the back face `eta_b`; when they differ the sheet
+    /// has the front coating of the module doc).
     pub fn from_params(p: &PaperParams, channel: usize) -> Result<SlabSpec, SlabError> {
         if channel > 2 {
             return Err(SlabError::Discretisation {
@@ -199,11 +237,6 @@ impl SlabSpec {
         ParamError::check_range("eta_b", self.back.eta(), ETA_RANGE.0, ETA_RANGE.1)?;
         self.front.dielectric("_f")?;
         self.back.dielectric("_b")?;
-        if self.front.eta() != self.back.eta() {
-            return Err(SlabError::Unsupported(
-                "faces of different indices (eta_f != eta_b: the coated sheet of docs/design.md 4.1)",
-            ));
-        }
         Ok(())
     }
 
@@ -215,8 +248,9 @@ impl SlabSpec {
     /// Everything of a solve that does not depend on the medium's albedo and
     /// optical thickness: the grids, the phase function's Fourier
     /// coefficients and the faces projected on the grids (the costly part of
-    /// a solve with rough faces). [`Prepared::solve`] then solves the sheet
-    /// for any albedo and thickness (one call per colour channel).
+    /// a solve with rough faces), and for a coated sheet the coating
+    /// (module doc). [`Prepared::solve`] then solves the sheet for any albedo
+    /// and thickness (one call per colour channel).
     pub fn prepare(&self, disc: &Discretisation) -> Result<Prepared, SlabError> {
         self.validate()?;
         if disc.nodes < 2 {
@@ -234,23 +268,52 @@ impl SlabSpec {
             });
         }
         let outside = Grid::outside(disc.nodes);
-        let inside = Grid::inside(&outside, self.front.eta(), disc.tir_nodes);
+        let (eta_f, eta_b) = (self.front.eta(), self.back.eta());
+        let n_tir = disc.tir_nodes;
+        // The coating's grid (if any) and the medium's (module doc): the less
+        // dense medium's from the outside grid, the denser one's from that.
+        let (coat_grid, inside) = if eta_f == eta_b {
+            (None, Grid::inside(&outside, eta_b, n_tir))
+        } else if eta_f < eta_b {
+            let coat = Grid::inside(&outside, eta_f, n_tir);
+            let inside = Grid::denser(&coat, eta_b, n_tir);
+            (Some(coat), inside)
+        } else {
+            let inside = Grid::inside(&outside, eta_b, n_tir);
+            (Some(Grid::denser(&inside, eta_f, n_tir)), inside)
+        };
         let phase = phase_fourier(&self.medium.phase, &inside, disc.orders)?;
         let start = disc.start_thickness.unwrap_or_else(|| default_start_thickness(&inside));
-        let project = |face: &Face, suffix: &str| -> Result<ProjectedFace, SlabError> {
+        let project = |face: &Face, suffix: &str, below: &Grid| -> Result<ProjectedFace, SlabError> {
             let (bd, fs) = face.dielectric(suffix)?;
             let proj = Projection {
                 orders: disc.orders,
                 azimuth_points: disc.azimuth_points,
                 normalise: disc.normalise_faces,
             };
-            face_interface(&bd, fs, &outside, &inside, &proj)
+            face_interface(&bd, fs, &outside, below, &proj)
         };
-        let front = project(&self.front, "_f")?;
+        let front = project(&self.front, "_f", coat_grid.as_ref().unwrap_or(&inside))?;
         let back = if self.back == self.front {
             front.clone()
         } else {
-            project(&self.back, "_b")?
+            project(&self.back, "_b", &inside)?
+        };
+        let coating = match coat_grid {
+            None => None,
+            Some(grid) => {
+                let boundary = smooth_boundary(&grid, &inside)?;
+                let coated = front
+                    .orders
+                    .iter()
+                    .map(|l| l.add(&boundary))
+                    .collect::<Result<Vec<Layer>, SlabError>>()?;
+                Some(Coating {
+                    grid,
+                    boundary,
+                    front: coated,
+                })
+            }
         };
         Ok(Prepared {
             outside,
@@ -259,8 +322,25 @@ impl SlabSpec {
             start,
             orders: disc.orders,
             faces: [front, back],
+            coating,
         })
     }
+}
+
+/// The front coating of a coated sheet (`eta_f != eta_b`; module doc), on
+/// the coating's grid between the front face and the medium.
+#[derive(Clone, Debug)]
+pub struct Coating {
+    /// The coating's grid (index `eta_f`; [`crate::quad`]).
+    pub grid: Grid,
+    /// The smooth coating/base boundary (coating's grid on top, the
+    /// medium's below; the same in every Fourier order):
+    /// [`crate::interface::smooth_boundary`].
+    pub boundary: Layer,
+    /// Per Fourier order, the front face added to the boundary: the coated
+    /// front between the outside grid and the medium's grid, the
+    /// interreflections inside the coating summed.
+    pub front: Vec<Layer>,
 }
 
 /// The medium-independent part of a solve ([`SlabSpec::prepare`]).
@@ -268,7 +348,7 @@ impl SlabSpec {
 pub struct Prepared {
     /// The grid in air on either side of the sheet.
     pub outside: Grid,
-    /// The grid inside the medium.
+    /// The grid inside the medium (the base: index `eta_b`).
     pub inside: Grid,
     /// The phase function's Fourier coefficients on the inside grid.
     pub phase: PhaseFourier,
@@ -276,15 +356,21 @@ pub struct Prepared {
     pub start: f64,
     /// Fourier orders `0..orders`.
     pub orders: usize,
-    /// The front and back faces projected on the grids (air on top, medium
-    /// below: the back face's layer is used flipped).
+    /// The front and back faces projected on the grids (air on top, the
+    /// coating's grid (coated sheet) or the medium's below for the front,
+    /// the medium's below for the back, whose layer is used flipped). A
+    /// coated front's layer is the rough air/coating interface alone: its
+    /// `r_top` is that interface's reflection from outside, without the
+    /// coating/base boundary.
     pub faces: [ProjectedFace; 2],
+    /// The coating of a coated sheet (`eta_f != eta_b`), `None` otherwise.
+    pub coating: Option<Coating>,
 }
 
 impl Prepared {
     /// Solves the sheet for a medium of single-scattering albedo `albedo` in
     /// `[0, 1]` and optical thickness `tau` (the grids, phase function and
-    /// faces of [`SlabSpec::prepare`]): Fourier orders in parallel.
+    /// faces (and coating) of [`SlabSpec::prepare`]): Fourier orders in parallel.
     pub fn solve(&self, albedo: f64, tau: f64) -> Result<Solution, SlabError> {
         let [front, back] = &self.faces;
         let solved: Vec<(Layer, Layer, u32)> = (0..self.orders)
@@ -292,7 +378,11 @@ impl Prepared {
             .map(|m| {
                 let (med, k) = medium_layer(&self.inside, &self.phase, m, albedo, tau, self.start)?;
                 let med = med.into_layer();
-                let sheet = front.orders[m].add(&med)?.add(&back.orders[m].flipped())?;
+                let top = match &self.coating {
+                    Some(c) => &c.front[m],
+                    None => &front.orders[m],
+                };
+                let sheet = top.add(&med)?.add(&back.orders[m].flipped())?;
                 Ok((sheet, med, k))
             })
             .collect::<Result<_, SlabError>>()?;
@@ -301,6 +391,7 @@ impl Prepared {
         Ok(Solution {
             outside: self.outside.clone(),
             inside: self.inside.clone(),
+            coating: self.coating.as_ref().map(|c| c.grid.clone()),
             orders,
             medium,
             doublings,

@@ -97,7 +97,8 @@ fn bad_face_settings_are_typed_errors() {
     assert!(e.to_string().contains("m_f"), "{e}");
     let e = SlabSpec::from_params(&p, 3).unwrap_err();
     assert!(e.to_string().contains("channel"), "{e}");
+    // A coated front (eta_f != eta_b) is a sheet like any other (tests/coated.rs).
     let coated = PaperParams { eta_f: 1.6, ..p };
-    let e = SlabSpec::from_params(&coated, 0).unwrap_err();
-    assert!(e.to_string().contains("eta_f != eta_b"), "{e}");
+    let spec = SlabSpec::from_params(&coated, 0).unwrap();
+    assert_eq!((spec.front.eta(), spec.back.eta()), (1.6, coated.eta_b));
 }
