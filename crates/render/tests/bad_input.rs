@@ -75,7 +75,7 @@ fn good_scene_loads() {
 }
 
 /// `model = "slab"` loads (the sheet solved numerically); an unknown model
-/// names the allowed values; a sheet `slab` does not support names why.
+/// names the allowed values; a bad parameter of a `slab` sheet is named.
 #[test]
 fn paper_model_key() {
     let dir = tempfile::tempdir().unwrap();
@@ -90,9 +90,9 @@ fn paper_model_key() {
     contains_all(&m, &["materials.sheet", "slap", "paper", "slab"]);
     let m = load_err(
         dir.path(),
-        &GOOD.replace("preset = \"matte\"", "preset = \"glossy\"\nmodel = \"slab\""),
+        &GOOD.replace("preset = \"matte\"", "preset = \"glossy\"\nmodel = \"slab\"\nm_f = 2.0"),
     );
-    contains_all(&m, &["materials.sheet", "slab", "eta_f != eta_b"]);
+    contains_all(&m, &["materials.sheet", "m_f", "2"]);
 }
 
 #[test]

@@ -12,28 +12,7 @@ use paperbsdf_slab::SlabBsdf;
 use std::time::Instant;
 
 fn main() {
-    {
-        let p = preset("matte").unwrap();
-        let spec = paperbsdf_slab::SlabSpec::from_params(&p, 0).unwrap();
-        let disc = paperbsdf_slab::Discretisation {
-            orders: 32,
-            ..Default::default()
-        };
-        let t0 = Instant::now();
-        let prep = spec.prepare(&disc).unwrap();
-        let t1 = Instant::now();
-        let _s = prep.solve(spec.medium.albedo, spec.medium.tau).unwrap();
-        let t2 = Instant::now();
-        let _u = prep.solve(0.0, spec.medium.tau).unwrap();
-        let t3 = Instant::now();
-        println!(
-            "prepare {:.3} solve {:.3} unscattered {:.3}",
-            (t1 - t0).as_secs_f64(),
-            (t2 - t1).as_secs_f64(),
-            (t3 - t2).as_secs_f64()
-        );
-    }
-    for name in ["matte", "luster"] {
+    for name in ["matte", "luster", "glossy"] {
         let p = preset(name).expect("preset");
         let t0 = Instant::now();
         let b = SlabBsdf::new(&p).expect("build");
@@ -55,6 +34,3 @@ fn main() {
         println!();
     }
 }
-
-#[allow(dead_code)]
-fn timing() {}

@@ -5,17 +5,20 @@
 //! **The split into sharp and smooth parts.** What the grid cannot resolve is
 //! kept analytic:
 //! - the lit face's reflection ([`Component::Surface`]): core's face
-//!   ([`PaperBsdf::face_reflection`]: Walter et al. 2007 plus, for
-//!   `face_scattering = "multiple"`, its separable compensation lobe), or the
-//!   Fresnel delta of a smooth face. Its projection on the grid
+//!   ([`PaperBsdf::face_interface_reflection`]: Walter et al. 2007 plus, for
+//!   `face_scattering = "multiple"`, its separable compensation lobe; for a
+//!   coated front the interface's alone, the light its coating/base boundary
+//!   returns being in the solution), or the Fresnel delta of a smooth face
+//!   (a smooth coated front's with the coating's interreflections). Its projection on the grid
 //!   ([`crate::interface`]) is what the adding-doubling solution holds for
 //!   that face's first reflection, and it is subtracted from every Fourier
 //!   order, so nothing is counted twice;
 //! - for two smooth faces, the unscattered light: mirror-like internal
 //!   reflections and straight-through transmission are delta lobes, in
-//!   closed form (`T = (1-F)^2 a / (1 - F^2 a^2)`, internal reflection
-//!   `F (1-F)^2 a^2 / (1 - F^2 a^2)`, `a = exp(-tau / mu_t)` with `mu_t` the
-//!   refracted cosine, `F` Fresnel's unpolarised reflectance); the solution
+//!   closed form (equal indices: `T = (1-F)^2 a / (1 - F^2 a^2)`, internal
+//!   reflection `F (1-F)^2 a^2 / (1 - F^2 a^2)`, `a = exp(-tau / mu_t)` with
+//!   `mu_t` the refracted cosine, `F` Fresnel's unpolarised reflectance; a
+//!   coated front with the coating's interreflections, `SmoothSheet::delta`); the solution
 //!   with the medium's albedo set to 0 holds exactly these (diagonal
 //!   matrices), and it is subtracted.
 //!
@@ -70,6 +73,7 @@ use paperbsdf_core::geometry::sample_cosine_hemisphere;
 use paperbsdf_core::models::{Component, ComponentModel};
 use paperbsdf_core::paper::Side;
 use paperbsdf_core::{DVec3, PaperBsdf, PaperParams, Rgb};
+use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// Share of the table's draws that are cosine-weighted over both hemispheres
@@ -109,23 +113,122 @@ impl Default for SlabOptions {
 /// Delta lobes of the unscattered light through two smooth faces (module doc).
 #[derive(Clone, Copy, Debug)]
 struct SmoothSheet {
-    eta: f64,
+    /// Index of the front face (the coating's, when it differs from the base's).
+    eta_f: f64,
+    /// Index of the base (the medium) and of the back face.
+    eta_b: f64,
+    /// Optical thickness per channel.
     tau: Rgb,
 }
 
 impl SmoothSheet {
-    /// `(R, T)` of the delta lobes at outside cosine `mu` (R includes the first
-    /// surface's Fresnel reflection).
-    fn delta(&self, mu: f64) -> (Rgb, Rgb) {
-        let f = fresnel_dielectric(mu, self.eta);
-        let Some(mu_t) = cos_transmitted(mu, self.eta) else {
-            return (Rgb::splat(f), Rgb::ZERO);
+    /// `(R, T)` of the delta lobes for light at outside cosine `mu` arriving
+    /// at `side` (R includes the lit face's own reflection). With `F1`, `F2`,
+    /// `F3` the Fresnel reflectances of the air/coating interface, the
+    /// coating/base boundary (at the coating's cosine) and the base/air back
+    /// face, the coating reflects `R_c = F1 + (1-F1)^2 F2 / (1 - F1 F2)` from
+    /// air and `R_c' = F2 + (1-F2)^2 F1 / (1 - F1 F2)` from the base, and
+    /// transmits `T_c = (1-F1)(1-F2) / (1 - F1 F2)`; with `a = exp(-tau / mu_b)`
+    /// and `D = 1 - R_c' F3 a^2`: `T = T_c a (1-F3) / D` both ways,
+    /// `R_front = R_c + T_c^2 a^2 F3 / D`, `R_back = F3 + (1-F3)^2 a^2 R_c' / D`
+    /// (for `eta_f = eta_b`, `F2 = 0`: the single slab's
+    /// `(1-F)^2 a / (1 - F^2 a^2)`).
+    fn delta(&self, side: Side, mu: f64) -> (Rgb, Rgb) {
+        let f1 = fresnel_dielectric(mu, self.eta_f);
+        let f3 = fresnel_dielectric(mu, self.eta_b);
+        let mu_c = cos_transmitted(mu, self.eta_f).map_or(0.0, f64::abs);
+        let f2 = if self.eta_f == self.eta_b {
+            0.0
+        } else {
+            fresnel_dielectric(mu_c, self.eta_b / self.eta_f)
         };
-        let mu_t = mu_t.abs();
-        let a = self.tau.map(|t| (-t / mu_t).exp());
-        let t = a.map(|a| (1.0 - f) * (1.0 - f) * a / (1.0 - f * f * a * a));
-        let r = a.map(|a| f + f * (1.0 - f) * (1.0 - f) * a * a / (1.0 - f * f * a * a));
+        let mu_b = cos_transmitted(mu, self.eta_b).map_or(0.0, f64::abs);
+        let den = 1.0 - f1 * f2;
+        let (rc, rc_in, tc) = if den > 0.0 {
+            (
+                f1 + (1.0 - f1) * (1.0 - f1) * f2 / den,
+                f2 + (1.0 - f2) * (1.0 - f2) * f1 / den,
+                (1.0 - f1) * (1.0 - f2) / den,
+            )
+        } else {
+            (1.0, 1.0, 0.0)
+        };
+        if mu_b <= 0.0 {
+            let r = if side == Side::Front { rc } else { f3 };
+            return (Rgb::splat(r), Rgb::ZERO);
+        }
+        let a = self.tau.map(|t| (-t / mu_b).exp());
+        let d = a.map(|a| 1.0 - rc_in * f3 * a * a);
+        let t = a.zip(d, |a, d| tc * a * (1.0 - f3) / d);
+        let r = match side {
+            Side::Front => a.zip(d, |a, d| rc + tc * tc * a * a * f3 / d),
+            Side::Back => a.zip(d, |a, d| f3 + (1.0 - f3) * (1.0 - f3) * a * a * rc_in / d),
+        };
         (r, t)
+    }
+}
+
+/// Fourier coefficients per `[side of incidence][transmit]` (module doc), with
+/// the number of orders that matter for each node pair.
+#[derive(Clone, Debug, Default)]
+struct Tables {
+    /// `c_m[o][j]` at `(o n + j) M + m`.
+    c: [[Vec<Rgb>; 2]; 2],
+    /// Per `(o n + j)`: the orders `0..len` whose coefficients exceed
+    /// [`ORDER_CUTOFF`] of the pair's largest (the same for a pair and its
+    /// reciprocal, so truncation keeps reciprocity exact).
+    len: [[Vec<u16>; 2]; 2],
+}
+
+/// Relative size below which a pair's higher Fourier orders are dropped
+/// (their sum changes `f` by at most `orders * ORDER_CUTOFF` of the pair's
+/// largest coefficient), and absolute size below which a coefficient is 0
+/// (no subnormal arithmetic in `eval`).
+const ORDER_CUTOFF: f64 = 1e-9;
+const TINY: f64 = 1e-200;
+
+impl Tables {
+    /// Truncates the orders of every node pair (`n` nodes, `orders` orders).
+    fn truncate(c: [[Vec<Rgb>; 2]; 2], n: usize, orders: usize) -> Tables {
+        let mut c = c;
+        let mut len: [[Vec<u16>; 2]; 2] = Default::default();
+        for tab in c.iter_mut().flatten() {
+            for v in tab.iter_mut() {
+                *v = v.map(|x| if x.abs() < TINY { 0.0 } else { x });
+            }
+        }
+        for (s, side) in c.iter().enumerate() {
+            for (t, tab) in side.iter().enumerate() {
+                len[s][t] = (0..n * n)
+                    .map(|p| {
+                        let coef = &tab[p * orders..(p + 1) * orders];
+                        let big = coef
+                            .iter()
+                            .map(|v| v.0.iter().fold(0.0f64, |a, x| a.max(x.abs())))
+                            .fold(0.0, f64::max);
+                        let last = coef
+                            .iter()
+                            .rposition(|v| v.0.iter().any(|x| x.abs() > ORDER_CUTOFF * big))
+                            .map_or(0, |m| m + 1);
+                        last.max(1) as u16
+                    })
+                    .collect();
+            }
+        }
+        // Reciprocal pairs keep the same orders: reflection (o, j) <-> (j, o)
+        // on one side, transmission (o, j) from the front <-> (j, o) from the back.
+        let mut sym = len.clone();
+        for o in 0..n {
+            for j in 0..n {
+                for s in 0..2 {
+                    sym[s][0][o * n + j] = len[s][0][o * n + j].max(len[s][0][j * n + o]);
+                }
+                let tf = len[0][1][o * n + j].max(len[1][1][j * n + o]);
+                sym[0][1][o * n + j] = tf;
+                sym[1][1][j * n + o] = tf;
+            }
+        }
+        Tables { c, len: sym }
     }
 }
 
@@ -152,9 +255,9 @@ pub struct SlabBsdf {
     /// Fourier orders.
     orders: usize,
     /// `[side of incidence][transmit]`: coefficients `c_m[o][j]` at `(o n + j) M + m`.
-    table: [[Vec<Rgb>; 2]; 2],
+    table: Tables,
     /// The same for the unscattered part of the table (component `direct`).
-    direct: [[Vec<Rgb>; 2]; 2],
+    direct: Tables,
     /// Delta lobes of two smooth faces.
     smooth: Option<SmoothSheet>,
     /// Bins in `mu` (uniform) and in `|phi|` (uniform on `[0, pi]`) of the sampling cells.
@@ -166,6 +269,8 @@ pub struct SlabBsdf {
     table_albedo: [Vec<f64>; 2],
     is_rgb: bool,
     flags: BsdfFlags,
+    /// Per face: the factors `s_j` of the face's crossings (see `with_options`).
+    crossing: [Vec<f64>; 2],
 }
 
 /// The place of `mu` among ascending `nodes`: `(i, t)` with `f = (1 - t) f_i + t f_{i+1}`.
@@ -256,8 +361,19 @@ impl SlabBsdf {
         let n = g.len();
         let m_count = opts.orders;
         // The faces' first reflection from outside, per order: the front
-        // face's r_top, the back face's (used flipped) r_top.
-        let face_r = |side: usize, m: usize| -> &DMatrix<f64> { &prepared.faces[side].orders[m].r_top };
+        // face's r_top, the back face's (used flipped) r_top. A smooth
+        // coated front reflects a delta lobe that includes the light its
+        // coating/base boundary sends back (core's face reflectance): the
+        // coated front's r_top. (A rough coated front's analytic reflection is
+        // the interface's alone, `face_interface_reflection`, and the light
+        // the boundary returns stays in the table.)
+        let front_smooth_coated = paper.face_is_smooth(Side::Front) && prepared.coating.is_some();
+        let face_r = |side: usize, m: usize| -> &DMatrix<f64> {
+            match (&prepared.coating, side) {
+                (Some(c), 0) if front_smooth_coated => &c.front[m].r_top,
+                _ => &prepared.faces[side].orders[m].r_top,
+            }
+        };
         fn block(sol: &Solution, side: usize, transmit: bool, m: usize) -> &DMatrix<f64> {
             let l = &sol.orders[m];
             match (side, transmit) {
@@ -267,6 +383,43 @@ impl SlabBsdf {
                 (_, true) => &l.t_up,
             }
         }
+        // The light the table holds crossed the lit face (and left through a
+        // face) as projected on the grid, whose transmittance per node is
+        // normalised with the reflection (R + T is core's) but whose split
+        // between R and T is off by the error of the projected reflection;
+        // with the reflection replaced by the exact one, the crossings are
+        // rescaled to the transmittance that the exact reflection leaves:
+        // `s_j = 1 - (R_exact(mu_j) - R_proj(j)) / T_proj(j)`, per face and
+        // node, applied as `s(o) s(j)` (reciprocal). Smooth faces are exact
+        // (s = 1).
+        let crossing = |side: Side| -> Vec<f64> {
+            let s = side as usize;
+            if paper.face_is_smooth(side) {
+                return vec![1.0; n];
+            }
+            let layer = &prepared.faces[s].orders[0];
+            let below = match (&prepared.coating, side) {
+                (Some(c), Side::Front) => &c.grid,
+                _ => &prepared.inside,
+            };
+            (0..n)
+                .map(|j| {
+                    let wj = g.w[j] * g.mu[j];
+                    let r_proj: f64 = (0..n).map(|o| g.w[o] * g.mu[o] * layer.r_top[(o, j)]).sum::<f64>() / wj;
+                    let t_proj: f64 = (0..below.len())
+                        .map(|i| below.w[i] * below.mu[i] * layer.t_down[(i, j)])
+                        .sum::<f64>()
+                        / wj;
+                    let r_exact = paper.face_interface_reflectance(side, g.mu[j]);
+                    if t_proj > 0.0 {
+                        (1.0 - (r_exact - r_proj) / t_proj).max(0.0)
+                    } else {
+                        1.0
+                    }
+                })
+                .collect()
+        };
+        let cross = [crossing(Side::Front), crossing(Side::Back)];
         let mut table: [[Vec<Rgb>; 2]; 2] = Default::default();
         let mut direct: [[Vec<Rgb>; 2]; 2] = Default::default();
         for side in 0..2 {
@@ -279,7 +432,8 @@ impl SlabBsdf {
                         let (kf, ku) = (block(full, side, transmit, m), block(unsc, side, transmit, m));
                         for o in 0..n {
                             for j in 0..n {
-                                let scale = eps / (2.0 * PI * g.w[j] * g.mu[j]);
+                                let exit = if transmit { 1 - side } else { side };
+                                let scale = eps / (2.0 * PI * g.w[j] * g.mu[j]) * cross[side][j] * cross[exit][o];
                                 let surface = if transmit { 0.0 } else { face_r(side, m)[(o, j)] };
                                 let (vt, vd) = if both_smooth {
                                     (kf[(o, j)] - ku[(o, j)], 0.0)
@@ -305,8 +459,13 @@ impl SlabBsdf {
                 direct[side][t] = dir;
             }
         }
+        let (table, direct) = (
+            Tables::truncate(table, n, m_count),
+            Tables::truncate(direct, n, m_count),
+        );
         let smooth = both_smooth.then(|| SmoothSheet {
-            eta: specs[0].front.eta(),
+            eta_f: specs[0].front.eta(),
+            eta_b: specs[0].back.eta(),
             tau: Rgb([specs[0].medium.tau, specs[1].medium.tau, specs[2].medium.tau]),
         });
         let front_smooth = paper.face_is_smooth(Side::Front);
@@ -331,9 +490,11 @@ impl SlabBsdf {
             table_albedo: [Vec::new(), Vec::new()],
             is_rgb: p.is_rgb(),
             flags,
+            crossing: cross,
         };
         for side in Side::BOTH {
-            let (cells, albedo): (Vec<CellDensity>, Vec<f64>) = (0..n).map(|j| me.cell_density(side, me.mu[j])).unzip();
+            let (cells, albedo): (Vec<CellDensity>, Vec<f64>) =
+                (0..n).into_par_iter().map(|j| me.cell_density(side, me.mu[j])).unzip();
             me.cells[side as usize] = cells;
             me.table_albedo[side as usize] = albedo;
         }
@@ -394,30 +555,30 @@ impl SlabBsdf {
 
     /// The table `tab` at `(wi, wo)` (module doc), before clamping.
     #[inline]
-    fn eval_table(&self, tab: &[[Vec<Rgb>; 2]; 2], wi: DVec3, wo: DVec3) -> Rgb {
+    fn eval_table(&self, tab: &Tables, wi: DVec3, wo: DVec3) -> Rgb {
         let side = Side::of(wi);
         let transmit = wi.z * wo.z < 0.0;
-        let t = &tab[side as usize][transmit as usize];
+        let t = &tab.c[side as usize][transmit as usize];
+        let lens = &tab.len[side as usize][transmit as usize];
         let n = self.mu.len();
         let mcount = self.orders;
         let (j, tj) = locate(&self.mu, wi.z.abs());
         let (o, to) = locate(&self.mu, wo.z.abs());
         let c = cos_phi(wi, wo);
-        let mut cos_m = [0.0f64; MAX_ORDERS];
-        cos_m[0] = 1.0;
-        if mcount > 1 {
-            cos_m[1] = c;
-            for m in 2..mcount {
-                cos_m[m] = 2.0 * c * cos_m[m - 1] - cos_m[m - 2];
-            }
-        }
         let corner = |oo: usize, jj: usize| -> Rgb {
-            let base = (oo * n + jj) * mcount;
+            let pair = oo * n + jj;
+            let base = pair * mcount;
+            let len = lens[pair] as usize;
+            // cos(m phi) by the Chebyshev recurrence, m = 0, 1, ...
+            let (mut c_prev, mut c_m) = (c, 1.0);
             let mut acc = [0.0f64; 3];
-            for (cm, cosv) in t[base..base + mcount].iter().zip(&cos_m[..mcount]) {
-                acc[0] += cm.0[0] * cosv;
-                acc[1] += cm.0[1] * cosv;
-                acc[2] += cm.0[2] * cosv;
+            for cm in &t[base..base + len] {
+                acc[0] += cm.0[0] * c_m;
+                acc[1] += cm.0[1] * c_m;
+                acc[2] += cm.0[2] * c_m;
+                let next = 2.0 * c * c_m - c_prev;
+                c_prev = c_m;
+                c_m = next;
             }
             Rgb(acc)
         };
@@ -436,6 +597,14 @@ impl SlabBsdf {
         f
     }
 
+    /// The factors by which the table's light crossing the face on `side`
+    /// at each node was rescaled so that the face's transmittance is the one
+    /// its exact (analytic) reflection leaves (1 for smooth faces; a measure
+    /// of how far the projected face's split between R and T was).
+    pub fn crossing_factors(&self, side: Side) -> &[f64] {
+        &self.crossing[side as usize]
+    }
+
     /// The solved outside nodes (ascending, the last `mu = 1`).
     pub fn nodes(&self) -> &[f64] {
         &self.mu
@@ -443,12 +612,15 @@ impl SlabBsdf {
 
     /// Memory held by the tables and sampling densities, in bytes.
     pub fn memory_bytes(&self) -> usize {
-        let tables: usize = self
-            .table
+        let tables: usize = [&self.table, &self.direct]
             .iter()
-            .chain(self.direct.iter())
-            .flat_map(|s| s.iter())
-            .map(|v| v.len() * std::mem::size_of::<Rgb>())
+            .map(|t| {
+                t.c.iter()
+                    .flatten()
+                    .map(|v| v.len() * std::mem::size_of::<Rgb>())
+                    .sum::<usize>()
+                    + t.len.iter().flatten().map(|v| v.len() * 2).sum::<usize>()
+            })
             .sum();
         let cells: usize = self
             .cells
@@ -464,7 +636,7 @@ impl SlabBsdf {
         let side = Side::of(wo);
         let mu = wo.z.abs().min(1.0);
         let (r_delta, t_delta) = match &self.smooth {
-            Some(s) => s.delta(mu),
+            Some(s) => s.delta(side, mu),
             None if self.paper.face_is_smooth(side) => (Rgb::splat(self.paper.face_reflectance(side, mu)), Rgb::ZERO),
             None => (Rgb::ZERO, Rgb::ZERO),
         };
@@ -481,7 +653,11 @@ impl SlabBsdf {
 
     /// Probabilities of (surface, delta R, delta T, table) at `wo`, summing to 1 (or all 0).
     fn lobe_probs(&self, wo: DVec3) -> [f64; 4] {
-        let (s, rd, td, tab) = self.lobe_weights(wo);
+        Self::probs_of(self.lobe_weights(wo))
+    }
+
+    /// [`SlabBsdf::lobe_probs`] from the weights of [`SlabBsdf::lobe_weights`].
+    fn probs_of((s, rd, td, tab): (f64, Rgb, Rgb, f64)) -> [f64; 4] {
         let w = [s, rd.mean(), td.mean(), tab];
         let total: f64 = w.iter().sum();
         if total > 0.0 {
@@ -489,6 +665,18 @@ impl SlabBsdf {
         } else {
             [0.0; 4]
         }
+    }
+
+    /// The mixture's density of `wi` for `wo` given the lobe probabilities at `wo`.
+    fn pdf_given(&self, probs: &[f64; 4], wi: DVec3, wo: DVec3) -> f64 {
+        let mut p = 0.0;
+        if probs[0] > 0.0 {
+            p += probs[0] * self.paper.face_reflection_pdf(wi, wo);
+        }
+        if probs[3] > 0.0 {
+            p += probs[3] * self.table_pdf(wi, wo);
+        }
+        p
     }
 
     /// The table's density of `wi` for `wo` (no lobe probability): the
@@ -564,7 +752,7 @@ impl SlabBsdf {
     fn eval_all(&self, wi: DVec3, wo: DVec3) -> Rgb {
         let table = self.eval_table(&self.table, wi, wo).map(|x| x.max(0.0));
         if wi.z * wo.z > 0.0 {
-            table + Rgb::splat(self.paper.face_reflection(Side::of(wi), wi, wo))
+            table + Rgb::splat(self.paper.face_interface_reflection(Side::of(wi), wi, wo))
         } else {
             table
         }
@@ -583,11 +771,12 @@ impl Bsdf for SlabBsdf {
         if wo.z == 0.0 {
             return None;
         }
-        let probs = self.lobe_probs(wo);
+        let weights = self.lobe_weights(wo);
+        let (_, rd, td, _) = weights;
+        let probs = Self::probs_of(weights);
         let (lobe, start) = paperbsdf_core::bsdf::select_lobe(uc, &probs)?;
         let v = ((uc - start) / probs[lobe]).clamp(0.0, 1.0 - 1e-16);
         let mu = wo.z.abs();
-        let (_, rd, td, _) = self.lobe_weights(wo);
         let wi = match lobe {
             1 => {
                 let wi = DVec3::new(-wo.x, -wo.y, wo.z);
@@ -612,7 +801,7 @@ impl Bsdf for SlabBsdf {
         if wi.z == 0.0 {
             return None;
         }
-        let pdf = self.pdf(wi, wo);
+        let pdf = self.pdf_given(&probs, wi, wo);
         if pdf <= 0.0 {
             return None;
         }
@@ -638,15 +827,7 @@ impl Bsdf for SlabBsdf {
         if wi.z == 0.0 || wo.z == 0.0 {
             return 0.0;
         }
-        let probs = self.lobe_probs(wo);
-        let mut p = 0.0;
-        if probs[0] > 0.0 {
-            p += probs[0] * self.paper.face_reflection_pdf(wi, wo);
-        }
-        if probs[3] > 0.0 {
-            p += probs[3] * self.table_pdf(wi, wo);
-        }
-        p
+        self.pdf_given(&self.lobe_probs(wo), wi, wo)
     }
 
     fn flags(&self) -> BsdfFlags {
@@ -662,7 +843,7 @@ impl ComponentModel for SlabBsdf {
         match c {
             Component::Surface => {
                 if wi.z * wo.z > 0.0 {
-                    Rgb::splat(self.paper.face_reflection(Side::of(wi), wi, wo))
+                    Rgb::splat(self.paper.face_interface_reflection(Side::of(wi), wi, wo))
                 } else {
                     Rgb::ZERO
                 }

@@ -205,6 +205,9 @@ pub(crate) struct Face {
     /// `sqrt(c_j) E_j` of the lobes on the [`NA`] nodes, side by side (zero
     /// for an absent lobe): what `eval` interpolates, one node lookup for both.
     lobe_tab: [[f64; 2]; NA],
+    /// The column of [`Face::lobe_tab`] that holds the coating's lobe (a
+    /// rough coated front), if any.
+    coat_lobe: Option<usize>,
     /// `rho_in` and `Tbar_in` for diffuse light from inside the base.
     rho_in: f64,
     tbar_in: f64,
@@ -261,6 +264,7 @@ impl Face {
             r_lobes_tab: [0.0; NA],
             lobes: Vec::new(),
             lobe_tab: [[0.0; 2]; NA],
+            coat_lobe: None,
             rho_in: 0.0,
             tbar_in: 0.0,
             iface_k: ifc.k,
@@ -308,6 +312,7 @@ impl Face {
                 f.lobes.push(l);
             }
             if let Some(l) = SeparableLobe::new(coat_e, 1.0) {
+                f.coat_lobe = Some(f.lobes.len());
                 f.lobes.push(l);
             }
         }
@@ -414,6 +419,21 @@ impl Face {
             return fresnel_dielectric(mu.abs().min(1.0), self.bd.eta);
         }
         lerp_mu(&self.r_tab, mu)
+    }
+
+    /// The directional reflectance of [`Face::interface_reflection`] (the
+    /// rough interface alone: [`Face::r_out`] without the coating's lobe)
+    /// for light from outside at cosine `mu`; for a face without
+    /// microfacets, its delta's reflectance.
+    pub fn interface_r_out(&self, mu: f64) -> f64 {
+        let r = self.r_out(mu);
+        match self.coat_lobe {
+            Some(j) => {
+                let l = &self.lobes[j];
+                (r - l.albedo_scale * lerp_mu(&l.e, mu)).max(0.0)
+            }
+            None => r,
+        }
     }
 
     /// [`Face::r_out`] given `st = sqrt(min(|mu|, 1))`.
@@ -578,6 +598,32 @@ impl Face {
         } else {
             self.lobes_reflection(pi, po)
         };
+        self.fresnel_outside_sq(oh2) * mf.reflection_dg_c2(c2, wi.z, wo.z) + lobes
+    }
+
+    /// The reflection of the rough interface alone, `f_r(wi, wo)` (no cosine,
+    /// face frame, outside): [`Face::reflection`] without the coating's
+    /// separable lobe, i.e. Walter's lobe and, for `face_scattering =
+    /// "multiple"`, the compensation lobe. For a face without a coating it
+    /// is [`Face::reflection`]. (A numerical solution that follows the
+    /// light the coating/base boundary sends back out itself needs the
+    /// interface's first reflection only.)
+    pub fn interface_reflection(&self, wi: DVec3, wo: DVec3) -> f64 {
+        let Some(coat) = self.coat_lobe else {
+            return self.reflection(wi, wo);
+        };
+        let Interface::Rough(mf) = self.bd.interface else {
+            return 0.0;
+        };
+        let Some((c2, oh2)) = reflection_half(wi, wo) else {
+            return 0.0;
+        };
+        let (pi, po) = (TabPos::new(wi.z.min(1.0).sqrt()), TabPos::new(wo.z.min(1.0).sqrt()));
+        let node = |p: TabPos, j: usize| self.lobe_tab[p.i][j] * (1.0 - p.f) + self.lobe_tab[p.i + 1][j] * p.f;
+        let lobes: f64 = (0..self.lobes.len())
+            .filter(|&j| j != coat)
+            .map(|j| node(pi, j) * node(po, j))
+            .sum();
         self.fresnel_outside_sq(oh2) * mf.reflection_dg_c2(c2, wi.z, wo.z) + lobes
     }
 

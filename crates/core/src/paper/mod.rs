@@ -514,6 +514,24 @@ impl PaperBsdf {
         self.faces[side].reflection(side.local(wi), side.local(wo))
     }
 
+    /// [`PaperBsdf::face_reflection`] of the rough interface alone: for a
+    /// coated front (`eta_f != eta_b`) without the separable lobe of the
+    /// light that the coating/base boundary sends back out (the same as
+    /// `face_reflection` otherwise).
+    pub fn face_interface_reflection(&self, side: Side, wi: DVec3, wo: DVec3) -> f64 {
+        if side.local(wi).z <= 0.0 || side.local(wo).z <= 0.0 {
+            return 0.0;
+        }
+        self.faces[side].interface_reflection(side.local(wi), side.local(wo))
+    }
+
+    /// Directional reflectance of [`PaperBsdf::face_interface_reflection`]
+    /// for light from outside at cosine `mu` (for a coated front without the
+    /// coating's returned light; [`PaperBsdf::face_reflectance`] otherwise).
+    pub fn face_interface_reflectance(&self, face: Side, mu: f64) -> f64 {
+        self.faces[face].interface_r_out(mu)
+    }
+
     /// Draws a reflected `wi` (sheet frame) from the visible normals of the
     /// face on the side of `wo` (Walter's lobe only; `None` for a face
     /// without microfacets or a draw below the face), density [`PaperBsdf::face_reflection_pdf`].
