@@ -45,8 +45,8 @@ __all__ = [
     "fit",
 ]
 
-#: Model names (docs/design.md 4.7): ``paper`` and ``reduced-multilayer`` take the
-#: Paper BSDF's parameters, ``lambert-glass`` takes ``k_d, k_t, eta, m, dist``,
+#: Model names (docs/design.md 4.7): ``paper``, ``reduced-multilayer`` and ``slab``
+#: (the same sheet solved numerically) take the Paper BSDF's parameters, ``lambert-glass`` takes ``k_d, k_t, eta, m, dist``,
 #: ``rough-dielectric`` takes ``eta, m, dist``.
 MODEL_NAMES = tuple(_native.model_names())  # from the Rust registry (ModelKind)
 

@@ -10,8 +10,9 @@ Properties (scene XML ``<string name=... value=.../>`` or ``load_dict`` keys):
 - ``params``: the parameters, inline JSON or a path to a JSON/TOML file
   (docs/design.md section 3), or
 - ``preset``: ``matte``, ``luster`` or ``glossy``;
-- ``model``: ``paper`` (default), ``reduced-multilayer``, ``lambert-glass``
-  or ``rough-dielectric``;
+- ``model``: ``paper`` (default), ``reduced-multilayer``, ``slab`` (the
+  same sheet solved numerically, crates/slab), ``lambert-glass`` or
+  ``rough-dielectric``;
 - ``mode``: ``auto`` (default), ``native`` or ``exact`` (below).
 
 Conventions (paperbsdf's: docs/design.md section 2). Mitsuba 3 (radiance transport) gives the BSDF ``si.wi``, the
@@ -38,7 +39,7 @@ Two evaluation paths, chosen by the property ``mode``:
   variants.
 - ``exact``: the Rust model itself. In a scalar variant one call into Rust
   per direction; in a JIT variant one call per wavefront (the GIL
-  released, all cores). The only path for ``lambert-glass`` and
+  released, all cores). The only path for ``slab``, ``lambert-glass`` and
   ``rough-dielectric``. In a JIT variant a wavefront must exist as data
   before it can go to native code, which needs Dr.Jit's *evaluated* loops
   and calls: creating an ``exact`` plugin in a JIT variant switches
@@ -67,6 +68,9 @@ import paperbsdf as _pb
 PLUGIN_NAME = "paperbsdf"
 _PROPERTIES = ("params", "preset", "model", "mode")
 _MODES = ("auto", "native", "exact")
+#: The models the native path ports (the Paper BSDF's closed forms); `slab`,
+#: the same sheet solved numerically, and the others run on the exact path.
+_NATIVE_MODELS = ("paper", "reduced-multilayer")
 
 _registered_variants: set = set()
 
@@ -237,10 +241,10 @@ def _make_class(mi, dr):
                 raise ValueError(f"paperbsdf plugin: mode `{mode}` is unknown; known modes: {', '.join(_MODES)}")
             self.model = _pb.Bsdf(model, params)
             self._source = params if isinstance(params, str) else json.dumps(params)
-            native_ok = model in _pb._PAPER_MODELS and rgb and self.model._native.paper_state is not None
+            native_ok = model in _NATIVE_MODELS and rgb and self.model._native.paper_state is not None
             if mode == "native" and not native_ok:
                 raise ValueError(
-                    f"paperbsdf plugin: mode `native` covers the models {', '.join(_pb._PAPER_MODELS)} in RGB "
+                    f"paperbsdf plugin: mode `native` covers the models {', '.join(_NATIVE_MODELS)} in RGB "
                     f"variants, not model `{model}` in `{mi.variant()}`; use mode `exact`"
                 )
             self._native = None
