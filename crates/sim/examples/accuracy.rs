@@ -193,19 +193,33 @@ fn rms_log_of(points: &[&Point], nc: usize, value: impl Fn(&Point) -> Rgb) -> f6
 /// `slab`'s component errors: order 0 against its surface + direct, orders
 /// 1 and 2+ together against its scattered part (as [`component_errors`]).
 fn slab_component_errors(points: &[&Point], nc: usize) -> [f64; 2] {
-    let mut out = [0.0; 2];
+    relative_errors(points, nc, |p, k, c| {
+        let (_, parts) = p.slab.as_ref()?;
+        let sim = if k == 0 {
+            p.sim_order[0].mean.0[c]
+        } else {
+            p.sim_order[1].mean.0[c] + p.sim_order[2].mean.0[c]
+        };
+        Some((parts[k].0[c], sim))
+    })
+}
+
+/// Per part `k < K`: the RMS over points and channels of
+/// `(model - sim) / (f_sim + e)`, with `(model, sim) = part(point, k, channel)`
+/// (points where it is `None` left out).
+fn relative_errors<const K: usize>(
+    points: &[&Point],
+    nc: usize,
+    part: impl Fn(&Point, usize, usize) -> Option<(f64, f64)>,
+) -> [f64; K] {
+    let mut out = [0.0; K];
     for (k, o) in out.iter_mut().enumerate() {
         let mut s = 0.0;
         let mut n = 0;
         for p in points {
-            let Some((_, parts)) = &p.slab else { continue };
             for c in 0..nc {
-                let sim = if k == 0 {
-                    p.sim_order[0].mean.0[c]
-                } else {
-                    p.sim_order[1].mean.0[c] + p.sim_order[2].mean.0[c]
-                };
-                s += ((parts[k].0[c] - sim) / (p.sim.mean.0[c] + E_LOG)).powi(2);
+                let Some((m, sim)) = part(p, k, c) else { continue };
+                s += ((m - sim) / (p.sim.mean.0[c] + E_LOG)).powi(2);
                 n += 1;
             }
         }
@@ -229,19 +243,9 @@ fn noise_floor(points: &[&Point], nc: usize) -> f64 {
 
 /// RMS over points and channels of (model_k - sim_k) / (sim + e), per order k.
 fn component_errors(points: &[&Point], nc: usize) -> [f64; 3] {
-    let mut out = [0.0; 3];
-    for (k, o) in out.iter_mut().enumerate() {
-        let mut s = 0.0;
-        let mut n = 0;
-        for p in points {
-            for c in 0..nc {
-                s += ((p.model_order[k].0[c] - p.sim_order[k].mean.0[c]) / (p.sim.mean.0[c] + E_LOG)).powi(2);
-                n += 1;
-            }
-        }
-        *o = (s / n.max(1) as f64).sqrt();
-    }
-    out
+    relative_errors(points, nc, |p, k, c| {
+        Some((p.model_order[k].0[c], p.sim_order[k].mean.0[c]))
+    })
 }
 
 const ORDER_NAMES: [&str; 3] = ["surface/unscattered", "single", "multiple"];

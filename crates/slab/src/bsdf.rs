@@ -345,17 +345,20 @@ impl SlabBsdf {
         let prepared = specs[0].prepare(&disc)?;
         let both_smooth = paper.face_is_smooth(Side::Front) && paper.face_is_smooth(Side::Back);
         // Solve each distinct channel: (full, unscattered).
-        let mut solved: Vec<(usize, Solution, Solution)> = Vec::new();
+        // Each distinct medium solved once, with and without scattering;
+        // `solution_of[c]` is channel c's.
+        let mut solutions: Vec<(Solution, Solution)> = Vec::new();
+        let mut solution_of = [0usize; 3];
         for (c, spec) in specs.iter().enumerate() {
-            if let Some(k) = (0..c).find(|&k| specs[k].medium == spec.medium) {
-                let s = solved.iter().find(|s| s.0 == k).expect("solved earlier");
-                let (a, b) = (s.1.clone(), s.2.clone());
-                solved.push((c, a, b));
-                continue;
-            }
-            let full = prepared.solve(spec.medium.albedo, spec.medium.tau)?;
-            let unscattered = prepared.solve(0.0, spec.medium.tau)?;
-            solved.push((c, full, unscattered));
+            solution_of[c] = match (0..c).find(|&k| specs[k].medium == spec.medium) {
+                Some(k) => solution_of[k],
+                None => {
+                    let full = prepared.solve(spec.medium.albedo, spec.medium.tau)?;
+                    let unscattered = prepared.solve(0.0, spec.medium.tau)?;
+                    solutions.push((full, unscattered));
+                    solutions.len() - 1
+                }
+            };
         }
         let g = &prepared.outside;
         let n = g.len();
@@ -426,7 +429,8 @@ impl SlabBsdf {
             for (t, transmit) in [false, true].into_iter().enumerate() {
                 let mut tab = vec![Rgb::ZERO; n * n * m_count];
                 let mut dir = vec![Rgb::ZERO; n * n * m_count];
-                for (c, full, unsc) in &solved {
+                for (c, &k) in solution_of.iter().enumerate() {
+                    let (full, unsc) = &solutions[k];
                     for m in 0..m_count {
                         let eps = if m == 0 { 1.0 } else { 2.0 };
                         let (kf, ku) = (block(full, side, transmit, m), block(unsc, side, transmit, m));
@@ -449,8 +453,8 @@ impl SlabBsdf {
                                     (vt, vd)
                                 };
                                 let idx = (o * n + j) * m_count + m;
-                                tab[idx].0[*c] = vt * scale;
-                                dir[idx].0[*c] = vd * scale;
+                                tab[idx].0[c] = vt * scale;
+                                dir[idx].0[c] = vd * scale;
                             }
                         }
                     }

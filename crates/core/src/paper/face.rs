@@ -560,13 +560,16 @@ impl Face {
     /// the places of both cosines on the tables.
     #[inline(always)]
     pub fn lobes_reflection(&self, pi: TabPos, po: TabPos) -> f64 {
-        let node = |p: TabPos| {
-            let (i, f) = (p.i, p.f);
-            let (a, b) = (self.lobe_tab[i], self.lobe_tab[i + 1]);
-            [a[0] * (1.0 - f) + b[0] * f, a[1] * (1.0 - f) + b[1] * f]
-        };
-        let (a, b) = (node(pi), node(po));
+        let (a, b) = (self.lobe_node(pi), self.lobe_node(po));
         a[0] * b[0] + a[1] * b[1]
+    }
+
+    /// Both columns of [`Face::lobe_tab`] interpolated at the place `p`.
+    #[inline(always)]
+    fn lobe_node(&self, p: TabPos) -> [f64; 2] {
+        let (i, f) = (p.i, p.f);
+        let (a, b) = (self.lobe_tab[i], self.lobe_tab[i + 1]);
+        [a[0] * (1.0 - f) + b[0] * f, a[1] * (1.0 - f) + b[1] * f]
     }
 
     /// Reflection `f_r(wi, wo)` (no cosine) of the face, both directions in
@@ -609,22 +612,15 @@ impl Face {
     /// light the coating/base boundary sends back out itself needs the
     /// interface's first reflection only.)
     pub fn interface_reflection(&self, wi: DVec3, wo: DVec3) -> f64 {
+        let r = self.reflection(wi, wo);
         let Some(coat) = self.coat_lobe else {
-            return self.reflection(wi, wo);
+            return r;
         };
-        let Interface::Rough(mf) = self.bd.interface else {
-            return 0.0;
-        };
-        let Some((c2, oh2)) = reflection_half(wi, wo) else {
-            return 0.0;
-        };
-        let (pi, po) = (TabPos::new(wi.z.min(1.0).sqrt()), TabPos::new(wo.z.min(1.0).sqrt()));
-        let node = |p: TabPos, j: usize| self.lobe_tab[p.i][j] * (1.0 - p.f) + self.lobe_tab[p.i + 1][j] * p.f;
-        let lobes: f64 = (0..self.lobes.len())
-            .filter(|&j| j != coat)
-            .map(|j| node(pi, j) * node(po, j))
-            .sum();
-        self.fresnel_outside_sq(oh2) * mf.reflection_dg_c2(c2, wi.z, wo.z) + lobes
+        let (a, b) = (
+            self.lobe_node(TabPos::new(wi.z.min(1.0).sqrt())),
+            self.lobe_node(TabPos::new(wo.z.min(1.0).sqrt())),
+        );
+        (r - a[coat] * b[coat]).max(0.0)
     }
 
     /// Density of [`Face::sample_reflection`]: `pdf_visible(wo, h) / (4 |wo.h|)`.
