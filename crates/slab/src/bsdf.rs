@@ -243,6 +243,41 @@ struct CellDensity {
     /// The density (solid angle) at the `phi` edges of the cells, per `(h, k)`
     /// `phi_bins + 1` values: linear in `|phi|` between them.
     edge: Vec<f64>,
+    /// Guide table of the search in `cdf` (indexed search, Chen and Asau
+    /// 1974): `guide[i]` is the first cell whose `cdf` exceeds `i / len`, so
+    /// the cell of `v` is found by a short forward scan from
+    /// `guide[floor(v len)]` (the same cell as a binary search, in O(1)
+    /// expected steps).
+    guide: Vec<u32>,
+}
+
+impl CellDensity {
+    /// The first cell whose cumulative probability exceeds `v` (the last if none does).
+    #[inline]
+    fn find(&self, v: f64) -> usize {
+        let last = self.cdf.len() - 1;
+        let g = ((v * self.guide.len() as f64) as usize).min(self.guide.len() - 1);
+        let mut i = self.guide[g] as usize;
+        while i < last && self.cdf[i] <= v {
+            i += 1;
+        }
+        i
+    }
+
+    /// The guide table of `cdf` (see [`CellDensity::guide`]).
+    fn guide_of(cdf: &[f64]) -> Vec<u32> {
+        let len = cdf.len();
+        let mut guide = Vec::with_capacity(len);
+        let mut i = 0usize;
+        for g in 0..len {
+            let v = g as f64 / len as f64;
+            while i + 1 < len && cdf[i] <= v {
+                i += 1;
+            }
+            guide.push(i as u32);
+        }
+        guide
+    }
 }
 
 /// The `slab` model (module doc).
@@ -554,7 +589,8 @@ impl SlabBsdf {
         } else {
             cdf.resize(prob.len(), 0.0);
         }
-        (CellDensity { cdf, prob, edge }, total)
+        let guide = CellDensity::guide_of(&cdf);
+        (CellDensity { cdf, prob, edge, guide }, total)
     }
 
     /// The table `tab` at `(wi, wo)` (module doc), before clamping.
@@ -630,7 +666,7 @@ impl SlabBsdf {
             .cells
             .iter()
             .flat_map(|s| s.iter())
-            .map(|c| (c.cdf.len() + c.prob.len() + c.edge.len()) * 8)
+            .map(|c| (c.cdf.len() + c.prob.len() + c.edge.len()) * 8 + c.guide.len() * 4)
             .sum();
         tables + cells
     }
@@ -721,7 +757,7 @@ impl SlabBsdf {
             j + 1
         };
         let cd = &self.cells[side as usize][node];
-        let cell = cd.cdf.partition_point(|&c| c <= v).min(cd.cdf.len() - 1);
+        let cell = cd.find(v);
         if cd.prob[cell] <= 0.0 {
             return None;
         }
@@ -866,5 +902,39 @@ impl ComponentModel for SlabBsdf {
 
     fn components(&self) -> &'static [Component] {
         &[Component::Surface, Component::Multiple, Component::Direct]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::CellDensity;
+
+    /// The guided search finds the cell a binary search finds, for every
+    /// kind of cdf: empty cells (flat runs), one cell holding everything,
+    /// and values on the cdf's steps.
+    #[test]
+    fn guided_search_is_the_binary_search() {
+        let cases: Vec<Vec<f64>> = vec![
+            vec![0.0, 0.0, 0.0, 1.0],
+            vec![1.0, 1.0, 1.0, 1.0],
+            vec![0.1, 0.1, 0.5, 0.5, 0.5, 0.9, 1.0],
+            (1..=100).map(|i| (i as f64 / 100.0).powi(4)).collect(),
+            (1..=64).map(|i| i as f64 / 64.0).collect(),
+        ];
+        for cdf in cases {
+            let cd = CellDensity {
+                guide: CellDensity::guide_of(&cdf),
+                prob: vec![0.0; cdf.len()],
+                edge: Vec::new(),
+                cdf: cdf.clone(),
+            };
+            let mut vs: Vec<f64> = (0..10_000).map(|i| i as f64 / 10_000.0).collect();
+            vs.extend(cdf.iter().copied().filter(|&c| c < 1.0));
+            vs.push(1.0 - 1e-16);
+            for v in vs {
+                let want = cdf.partition_point(|&c| c <= v).min(cdf.len() - 1);
+                assert_eq!(cd.find(v), want, "cdf {cdf:?} at v = {v}");
+            }
+        }
     }
 }
