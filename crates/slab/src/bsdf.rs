@@ -253,11 +253,17 @@ struct CellDensity {
 
 impl CellDensity {
     /// The first cell whose cumulative probability exceeds `v` (the last if none does).
+    /// `floor(v len)` can round up to the next guide entry for `v` just
+    /// below `g / len`, whose cell may then lie past `v`'s: the backward
+    /// step makes the result the binary search's for every `v`.
     #[inline]
     fn find(&self, v: f64) -> usize {
         let last = self.cdf.len() - 1;
         let g = ((v * self.guide.len() as f64) as usize).min(self.guide.len() - 1);
         let mut i = self.guide[g] as usize;
+        while i > 0 && self.cdf[i - 1] > v {
+            i -= 1;
+        }
         while i < last && self.cdf[i] <= v {
             i += 1;
         }
@@ -911,7 +917,7 @@ mod tests {
 
     /// The guided search finds the cell a binary search finds, for every
     /// kind of cdf: empty cells (flat runs), one cell holding everything,
-    /// and values on the cdf's steps.
+    /// values on the cdf's steps and just below the guide's steps.
     #[test]
     fn guided_search_is_the_binary_search() {
         let cases: Vec<Vec<f64>> = vec![
@@ -920,6 +926,12 @@ mod tests {
             vec![0.1, 0.1, 0.5, 0.5, 0.5, 0.9, 1.0],
             (1..=100).map(|i| (i as f64 / 100.0).powi(4)).collect(),
             (1..=64).map(|i| i as f64 / 64.0).collect(),
+            // A step at 9/10, where `floor(v len)` for `v` one ulp below it rounds to 9.
+            (1..=10).map(|i| i as f64 / 10.0).collect(),
+            // Steps one ulp below the guide's steps 1/4, 2/4, 3/4.
+            [0.25f64, 0.5, 0.75, 1.0]
+                .map(|x| if x < 1.0 { f64::from_bits(x.to_bits() - 1) } else { x })
+                .to_vec(),
         ];
         for cdf in cases {
             let cd = CellDensity {
@@ -931,6 +943,12 @@ mod tests {
             let mut vs: Vec<f64> = (0..10_000).map(|i| i as f64 / 10_000.0).collect();
             vs.extend(cdf.iter().copied().filter(|&c| c < 1.0));
             vs.push(1.0 - 1e-16);
+            // Just below and at the guide's own steps g / len, where
+            // `floor(v len)` rounds.
+            for g in 1..cdf.len() {
+                let at = g as f64 / cdf.len() as f64;
+                vs.extend([at, f64::from_bits(at.to_bits() - 1), f64::from_bits(at.to_bits() - 2)]);
+            }
             for v in vs {
                 let want = cdf.partition_point(|&c| c <= v).min(cdf.len() - 1);
                 assert_eq!(cd.find(v), want, "cdf {cdf:?} at v = {v}");
