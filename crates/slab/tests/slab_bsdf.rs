@@ -19,9 +19,11 @@ mod chi2;
 use paperbsdf_core::bsdf::albedo_from;
 use paperbsdf_core::geometry::spherical_direction;
 use paperbsdf_core::models::{Component, ComponentModel};
+use paperbsdf_core::paper::Side;
 use paperbsdf_core::presets::preset;
-use paperbsdf_core::{Bsdf, Colour, DVec3, Distribution, FaceScattering, PaperParams};
+use paperbsdf_core::{Bsdf, Colour, DVec3, Distribution, FaceScattering, PaperBsdf, PaperParams};
 use paperbsdf_slab::{SlabBsdf, SlabOptions, SlabSpec};
+use std::f64::consts::PI;
 
 fn sheet(d: f64, sa: f64, ss: f64, faces: [(f64, f64, Distribution); 2], fs: FaceScattering) -> PaperParams {
     PaperParams {
@@ -211,10 +213,10 @@ fn reciprocity_holds_for_unequal_faces() {
 }
 
 /// `albedo_from` integrates over the outgoing argument with every component
-/// and the delta lobes; 64 x 64 stratified samples.
+/// and the delta lobes: no albedo above 1 (96 x 96 stratified samples; the
+/// quasi-random estimator's own error is a few 1e-4, see below).
 #[test]
-fn energy_is_bounded_and_closes_without_absorption() {
-    // No albedo above 1.
+fn energy_is_bounded() {
     for (name, p) in cases() {
         let b = SlabBsdf::new(&p).unwrap();
         for side in [1.0, -1.0] {
@@ -225,39 +227,134 @@ fn energy_is_bounded_and_closes_without_absorption() {
             }
         }
     }
-    // A conservative sheet with energy-conserving faces closes: R + T = 1.
-    let p = sheet(
-        0.05,
-        0.0,
-        60.0,
-        [(1.5, 0.2, Distribution::Ggx), (1.5, 0.45, Distribution::Beckmann)],
-        FaceScattering::Multiple,
-    );
-    let coated = sheet(
-        0.05,
-        0.0,
-        60.0,
-        [(1.6, 0.25, Distribution::Beckmann), (1.45, 0.3, Distribution::Ggx)],
-        FaceScattering::Multiple,
-    );
-    let mut worst = 0.0f64;
-    for p in [p, coated] {
-        let b = SlabBsdf::new(&p).unwrap();
-        for side in [1.0, -1.0] {
-            for theta in [0.0, 25.0, 50.0, 70.0, 82.0] {
-                let (r, t) = albedo_from(&b, dir(theta, 0.2, side), 128);
-                let e = ((r + t).mean() - 1.0).abs();
-                worst = worst.max(e);
-                assert!(e < 5e-3, "R + T = {} at theta {theta} side {side}", (r + t).mean());
+}
+
+/// `int eval(wi, wo) |cos wo| dwo` over both hemispheres by a deterministic
+/// rule: in `mu_o` Gauss-Legendre (`per` points) on each interval between the
+/// table's nodes (where the table is linear in `mu_o`, so the rule is exact
+/// for it) and on `[0, mu_0]`, each interval also split in `split` equal parts
+/// (for the analytic face's lobe); in azimuth the midpoint rule with `n_phi`
+/// points, exact for the table's Fourier sum when `n_phi` exceeds twice the
+/// orders.
+fn grid_albedo(f: impl Fn(DVec3) -> f64, nodes: &[f64], per: usize, split: usize, n_phi: usize) -> f64 {
+    let (x, w) = paperbsdf_core::quadrature::gauss_legendre_01(per);
+    let mut edges = vec![0.0];
+    edges.extend_from_slice(nodes);
+    let mut total = 0.0;
+    for side in [1.0, -1.0] {
+        for e in edges.windows(2) {
+            let h = (e[1] - e[0]) / split as f64;
+            for part in 0..split {
+                let a = e[0] + part as f64 * h;
+                for (xk, wk) in x.iter().zip(&w) {
+                    let mu = a + xk * h;
+                    let s = (1.0 - mu * mu).max(0.0).sqrt();
+                    let mut ring = 0.0;
+                    for k in 0..n_phi {
+                        let phi = (k as f64 + 0.5) / n_phi as f64 * 2.0 * PI;
+                        let wo = DVec3::new(s * phi.cos(), s * phi.sin(), side * mu);
+                        ring += f(wo);
+                    }
+                    total += wk * h * mu * ring * 2.0 * PI / n_phi as f64;
+                }
             }
         }
     }
-    eprintln!("conservative sheet: |R + T - 1| <= {worst:.2e}");
+    total
+}
+
+/// Non-absorbing sheets with energy-conserving faces (`face_scattering =
+/// "multiple"`) close: `R + T = 1 +- 1e-4`, by [`grid_albedo`]
+/// (deterministic: `albedo_from`'s quasi-random estimate carries a bias of
+/// about -2e-4 of its own here, from its correlated strata over the table's
+/// discontinuous cells, so it cannot show 1e-4). Rough faces only (the rule
+/// has no delta lobes), among them a coated front and a thin, weakly
+/// scattering sheet (optical thickness 0.2 with a GGX 0.1 front: its
+/// unscattered light makes the narrowest table lobes, where the
+/// interpolation in `mu_o` integrated 4% above 1 before the tables were
+/// balanced), both sides, every 5 degrees from normal to 85 degrees (nodes
+/// and between them, where the interpolation in `mu_i` left 4e-4 before the
+/// crossing shapes).
+///
+/// What `slab` adds to the lit face is the table (components `direct` +
+/// `multiple`): its integral plus the face's reflectance (core's table,
+/// checked against direct quadrature in core's tests/rough_dielectric.rs)
+/// must be 1 within 2e-5 (measured: 7e-6; the rule is exact for the table's
+/// Fourier sum in azimuth and nearly so in `mu_o`). The whole `eval`,
+/// face included, is integrated too, up to 50 degrees (at grazing incidence
+/// the GGX 0.1 lobe needs a finer rule than a test can afford), within
+/// 1.5e-4, not 1e-4: the face's analytic lobe itself integrates to core's
+/// tabulated reflectance only within 1.0e-4 for the coated front (Beckmann
+/// 0.25, eta 1.6; measured by a converged 20000 x 256 rule: 0.053384 vs the
+/// table's 0.053478 at normal incidence; core's tests bound its tables at
+/// 1.3e-3). That is core's face, shared with `paper`, not `slab`'s error.
+#[test]
+fn energy_closes_without_absorption() {
+    let sheets = [
+        sheet(
+            0.05,
+            0.0,
+            60.0,
+            [(1.5, 0.2, Distribution::Ggx), (1.5, 0.45, Distribution::Beckmann)],
+            FaceScattering::Multiple,
+        ),
+        sheet(
+            0.05,
+            0.0,
+            60.0,
+            [(1.6, 0.25, Distribution::Beckmann), (1.45, 0.3, Distribution::Ggx)],
+            FaceScattering::Multiple,
+        ),
+        sheet(
+            0.02,
+            0.0,
+            10.0,
+            [(1.5, 0.1, Distribution::Ggx), (1.5, 0.3, Distribution::Beckmann)],
+            FaceScattering::Multiple,
+        ),
+    ];
+    let (mut worst_table, mut worst_total) = (0.0f64, 0.0f64);
+    for (k, p) in sheets.iter().enumerate() {
+        let b = SlabBsdf::new(p).unwrap();
+        let paper = PaperBsdf::new(p).unwrap();
+        for side in [1.0, -1.0] {
+            let face = if side > 0.0 { Side::Front } else { Side::Back };
+            for theta in (0..18).map(|i| 5.0 * i as f64) {
+                let wi = dir(theta, 0.2, side);
+                let table = grid_albedo(
+                    |wo| {
+                        (b.eval_component(wi, wo, Component::Direct) + b.eval_component(wi, wo, Component::Multiple))
+                            .mean()
+                    },
+                    b.nodes(),
+                    6,
+                    1,
+                    96,
+                );
+                let e = table + paper.face_interface_reflectance(face, wi.z.abs()) - 1.0;
+                worst_table = worst_table.max(e.abs());
+                assert!(
+                    e.abs() < 2e-5,
+                    "sheet {k}: table + face = 1 {e:+.2e} at theta {theta} side {side}"
+                );
+                if theta <= 50.0 {
+                    let total = grid_albedo(|wo| b.eval(wi, wo).mean(), b.nodes(), 6, 4, 192);
+                    worst_total = worst_total.max((total - 1.0).abs());
+                    assert!(
+                        (total - 1.0).abs() < 1.5e-4,
+                        "sheet {k}: R + T = {total} at theta {theta} side {side}"
+                    );
+                }
+            }
+        }
+    }
+    eprintln!("conservative sheets: |table + face - 1| <= {worst_table:.2e}, |R + T - 1| <= {worst_total:.2e} (to 50 degrees)");
 }
 
 /// At the nodes, in transmission, `eval` is the solution's BSDF with the
 /// faces' crossings rescaled (`crossing_factors`, which must stay within 3%
-/// of 1: the projected faces' R/T split is good to about 1e-3 in albedo).
+/// of 1: the projected faces' R/T split is good to about 1e-3 in albedo) and
+/// balanced (`balance_factors`, within 2%; the crossing shapes are 1 at the nodes).
 #[test]
 fn eval_at_the_nodes_is_the_solution() {
     let p = preset("luster").unwrap();
@@ -277,6 +374,11 @@ fn eval_at_the_nodes_is_the_solution() {
         for &s in b.crossing_factors(side) {
             assert!((s - 1.0).abs() < 0.03, "crossing factor {s}");
         }
+        // The interpolation's balance moves the nodes' values by little
+        // (luster's narrowest lobe is its Beckmann 0.15 front's).
+        for x in b.balance_factors(side) {
+            assert!((x.0[0] - 1.0).abs() < 0.02, "balance factor {}", x.0[0]);
+        }
     }
     for &j in &[3usize, 12, 20, n - 2] {
         for &o in &[5usize, 17, 25] {
@@ -289,8 +391,12 @@ fn eval_at_the_nodes_is_the_solution() {
                 // The table's crossings of the two faces are rescaled by
                 // the factors that make the faces' transmittance match their
                 // exact reflection (crossing_factors).
-                let s = b.crossing_factors(paperbsdf_core::paper::Side::Front)[j]
-                    * b.crossing_factors(paperbsdf_core::paper::Side::Back)[o];
+                // and balanced (balance_factors).
+                let (front, back) = (paperbsdf_core::paper::Side::Front, paperbsdf_core::paper::Side::Back);
+                let s = b.crossing_factors(front)[j]
+                    * b.crossing_factors(back)[o]
+                    * b.balance_factors(front)[j].0[0]
+                    * b.balance_factors(back)[o].0[0];
                 let want = s * sol.bsdf_at_nodes(paperbsdf_slab::Side::Front, true, o, j, phi);
                 let got = b.eval(wi, wo).0[0];
                 assert!(
