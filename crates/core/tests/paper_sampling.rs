@@ -234,3 +234,46 @@ fn sample_consistent_with_eval_and_pdf() {
         }
     }
 }
+
+/// `face_interface_reflection_and_pdf` is `face_interface_reflection` and
+/// `face_reflection_pdf` at once (the slab model's sampler uses it): the same
+/// values, for rough, coated (glossy: a Beckmann 0.04 coating over a base of
+/// another index) and smooth faces, both sides, in reflection and in
+/// transmission (both zero there), grazing directions included.
+#[test]
+fn face_reflection_and_pdf_at_once() {
+    use paperbsdf_core::paper::Side;
+    use paperbsdf_core::presets::preset;
+    let mut sheets: Vec<PaperParams> = ["matte", "luster", "glossy"]
+        .iter()
+        .map(|n| preset(n).unwrap())
+        .collect();
+    sheets.push(paper(
+        0.1,
+        Colour::Scalar(0.5),
+        Colour::Scalar(50.0),
+        [(1.5, 0.0, Distribution::Ggx), (1.6, 0.5, Distribution::Beckmann)],
+        (0.8, -0.3, 0.2),
+    ));
+    let mut n = 0;
+    for p in &sheets {
+        let b = PaperBsdf::new(p).unwrap();
+        for k in 0..400 {
+            let u = |a: f64| (0.5 + k as f64 * a).fract();
+            let half_pi = 0.9999 * std::f64::consts::FRAC_PI_2;
+            let (ti, to) = (u(0.618_033_988_7) * half_pi, u(0.754_877_666) * half_pi);
+            let si = if k % 2 == 0 { 1.0 } else { -1.0 };
+            let so = if k % 3 == 0 { -si } else { si };
+            let a = spherical_direction(ti, u(0.569_840_29) * std::f64::consts::TAU);
+            let c = spherical_direction(to, u(0.412_454_03) * std::f64::consts::TAU);
+            let (wi, wo) = (DVec3::new(a.x, a.y, si * a.z), DVec3::new(c.x, c.y, so * c.z));
+            let side = if wo.z > 0.0 { Side::Front } else { Side::Back };
+            let (f, pdf) = b.face_interface_reflection_and_pdf(side, wi, wo);
+            let (f0, pdf0) = (b.face_interface_reflection(side, wi, wo), b.face_reflection_pdf(wi, wo));
+            assert!((f - f0).abs() <= 1e-12 * f0.abs(), "f {f} vs {f0}");
+            assert!((pdf - pdf0).abs() <= 1e-12 * pdf0.abs(), "pdf {pdf} vs {pdf0}");
+            n += usize::from(f0 > 0.0);
+        }
+    }
+    assert!(n > 400, "too few directions with a face reflection: {n}");
+}

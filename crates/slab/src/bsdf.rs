@@ -253,6 +253,17 @@ impl Tables {
                 sym[1][1][j * n + o] = tf;
             }
         }
+        // Orders past a pair's length are zero, so that `eval_table` can sum
+        // its four corners over the longest of their lengths.
+        for s in 0..2 {
+            for t in 0..2 {
+                for (p, &l) in sym[s][t].iter().enumerate() {
+                    for v in &mut c[s][t][p * orders + l as usize..(p + 1) * orders] {
+                        *v = Rgb::ZERO;
+                    }
+                }
+            }
+        }
         Tables { c, len: sym }
     }
 }
@@ -508,6 +519,14 @@ fn balance_interpolation(
         }
     }
     [0, 1].map(|s| x.iter().map(|xj| Rgb(xj[s])).collect())
+}
+
+/// A direction placed among the nodes: its `z`, `mu = |z|` and [`locate`]'s `(i, t)`.
+#[derive(Clone, Copy, Debug)]
+struct Place {
+    z: f64,
+    mu: f64,
+    at: (usize, f64),
 }
 
 /// The place of `mu` among ascending `nodes`: `(i, t)` with `f = (1 - t) f_i + t f_{i+1}`.
@@ -810,48 +829,65 @@ impl SlabBsdf {
     /// The table `tab` at `(wi, wo)` (module doc), before clamping.
     #[inline]
     fn eval_table(&self, tab: &Tables, wi: DVec3, wo: DVec3) -> Rgb {
-        let side = Side::of(wi);
+        self.eval_table_at(tab, self.place(wi), self.place(wo), cos_phi(wi, wo))
+    }
+
+    /// Where `w` is among the nodes ([`Place`]).
+    #[inline]
+    fn place(&self, w: DVec3) -> Place {
+        let mu = w.z.abs();
+        Place {
+            z: w.z,
+            mu,
+            at: locate(&self.mu, mu),
+        }
+    }
+
+    /// [`SlabBsdf::eval_table`] with the directions placed among the nodes
+    /// and `c` the cosine of their azimuth difference ([`cos_phi`]). The four
+    /// corners (node pairs) are weighted first and summed in one Fourier
+    /// series over the longest of their orders (orders past a pair's length
+    /// are zero, [`Tables::truncate`]).
+    #[inline]
+    fn eval_table_at(&self, tab: &Tables, wi: Place, wo: Place, c: f64) -> Rgb {
+        let side = usize::from(wi.z < 0.0);
         let transmit = wi.z * wo.z < 0.0;
-        let t = &tab.c[side as usize][transmit as usize];
-        let lens = &tab.len[side as usize][transmit as usize];
+        let t = &tab.c[side][transmit as usize];
+        let lens = &tab.len[side][transmit as usize];
         let n = self.mu.len();
         let mcount = self.orders;
-        let (j, tj) = locate(&self.mu, wi.z.abs());
-        let (o, to) = locate(&self.mu, wo.z.abs());
-        let c = cos_phi(wi, wo);
-        let corner = |oo: usize, jj: usize| -> Rgb {
-            let pair = oo * n + jj;
-            let base = pair * mcount;
-            let len = lens[pair] as usize;
-            // cos(m phi) by the Chebyshev recurrence, m = 0, 1, ...
-            let (mut c_prev, mut c_m) = (c, 1.0);
-            let mut acc = [0.0f64; 3];
-            for cm in &t[base..base + len] {
-                acc[0] += cm.0[0] * c_m;
-                acc[1] += cm.0[1] * c_m;
-                acc[2] += cm.0[2] * c_m;
-                let next = 2.0 * c * c_m - c_prev;
-                c_prev = c_m;
-                c_m = next;
-            }
-            Rgb(acc)
-        };
-        let exit = if transmit { 1 - side as usize } else { side as usize };
-        let g = shape_at(&self.shape[side as usize], self.mu[0], wi.z.abs(), (j, tj))
-            * shape_at(&self.shape[exit], self.mu[0], wo.z.abs(), (o, to));
-        let mut f = Rgb::ZERO;
-        for (oo, wo_) in [(o, 1.0 - to), (o + 1, to)] {
-            if wo_ == 0.0 {
-                continue;
-            }
-            for (jj, wj) in [(j, 1.0 - tj), (j + 1, tj)] {
-                if wj == 0.0 {
-                    continue;
-                }
-                f += corner(oo, jj) * (wo_ * wj);
+        let ((j, tj), (o, to)) = (wi.at, wo.at);
+        let pairs = [o * n + j, o * n + j + 1, (o + 1) * n + j, (o + 1) * n + j + 1];
+        let weights = [(1.0 - to) * (1.0 - tj), (1.0 - to) * tj, to * (1.0 - tj), to * tj];
+        let mut len = 0usize;
+        for (p, w) in pairs.iter().zip(&weights) {
+            if *w != 0.0 {
+                len = len.max(lens[*p] as usize);
             }
         }
-        f * g
+        let rows = pairs.map(|p| &t[p * mcount..p * mcount + len]);
+        // cos(m phi) by the Chebyshev recurrence, m = 0, 1, ...
+        let (mut c_prev, mut c_m) = (c, 1.0);
+        let mut acc = [0.0f64; 3];
+        for m in 0..len {
+            let mut s = [0.0f64; 3];
+            for (row, w) in rows.iter().zip(&weights) {
+                let v = &row[m].0;
+                s[0] += v[0] * w;
+                s[1] += v[1] * w;
+                s[2] += v[2] * w;
+            }
+            acc[0] += s[0] * c_m;
+            acc[1] += s[1] * c_m;
+            acc[2] += s[2] * c_m;
+            let next = 2.0 * c * c_m - c_prev;
+            c_prev = c_m;
+            c_m = next;
+        }
+        let exit = if transmit { 1 - side } else { side };
+        let g = shape_at(&self.shape[side], self.mu[0], wi.mu, wi.at)
+            * shape_at(&self.shape[exit], self.mu[0], wo.mu, wo.at);
+        Rgb(acc) * g
     }
 
     /// The factors by which the table's light crossing the face on `side`
@@ -900,9 +936,9 @@ impl SlabBsdf {
     }
 
     /// The lobe probabilities at `wo`: (surface lobe, delta lobes, table).
-    fn lobe_weights(&self, wo: DVec3) -> (f64, Rgb, Rgb, f64) {
-        let side = Side::of(wo);
-        let mu = wo.z.abs().min(1.0);
+    fn lobe_weights(&self, wo: Place) -> (f64, Rgb, Rgb, f64) {
+        let side = if wo.z < 0.0 { Side::Back } else { Side::Front };
+        let mu = wo.mu.min(1.0);
         let (r_delta, t_delta) = match &self.smooth {
             Some(s) => s.delta(side, mu),
             None if self.paper.face_is_smooth(side) => (Rgb::splat(self.paper.face_reflectance(side, mu)), Rgb::ZERO),
@@ -913,18 +949,14 @@ impl SlabBsdf {
         } else {
             self.paper.face_reflectance(side, mu)
         };
-        let (j, t) = locate(&self.mu, mu);
+        let (j, t) = wo.at;
         let alb = &self.table_albedo[side as usize];
         let table = alb[j] * (1.0 - t) + alb[j + 1] * t;
         (surface, r_delta, t_delta, table)
     }
 
-    /// Probabilities of (surface, delta R, delta T, table) at `wo`, summing to 1 (or all 0).
-    fn lobe_probs(&self, wo: DVec3) -> [f64; 4] {
-        Self::probs_of(self.lobe_weights(wo))
-    }
-
-    /// [`SlabBsdf::lobe_probs`] from the weights of [`SlabBsdf::lobe_weights`].
+    /// Probabilities of (surface, delta R, delta T, table), summing to 1 (or
+    /// all 0), from the weights of [`SlabBsdf::lobe_weights`].
     fn probs_of((s, rd, td, tab): (f64, Rgb, Rgb, f64)) -> [f64; 4] {
         let w = [s, rd.mean(), td.mean(), tab];
         let total: f64 = w.iter().sum();
@@ -935,39 +967,41 @@ impl SlabBsdf {
         }
     }
 
-    /// The mixture's density of `wi` for `wo` given the lobe probabilities at `wo`.
-    fn pdf_given(&self, probs: &[f64; 4], wi: DVec3, wo: DVec3) -> f64 {
+    /// The mixture's density of `wi` for `wo` given the lobe probabilities
+    /// at `wo`, with `wo` placed among the nodes and `c` the cosine of the
+    /// azimuth difference ([`cos_phi`]).
+    fn pdf_given(&self, probs: &[f64; 4], wi: DVec3, wo: DVec3, wo_at: Place, c: f64) -> f64 {
         let mut p = 0.0;
         if probs[0] > 0.0 {
             p += probs[0] * self.paper.face_reflection_pdf(wi, wo);
         }
         if probs[3] > 0.0 {
-            p += probs[3] * self.table_pdf(wi, wo);
+            p += probs[3] * self.table_pdf(wi, wo_at, c);
         }
         p
     }
 
     /// The table's density of `wi` for `wo` (no lobe probability): the
     /// interpolated cell densities, mixed with the cosine share.
-    fn table_pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
-        let side = Side::of(wo);
-        let (j, t) = locate(&self.mu, wo.z.abs());
+    fn table_pdf(&self, wi: DVec3, wo: Place, c: f64) -> f64 {
+        let side = usize::from(wo.z < 0.0);
+        let (j, t) = wo.at;
         let h = usize::from(wi.z * wo.z <= 0.0);
         let k = ((wi.z.abs() * self.mu_bins as f64) as usize).min(self.mu_bins - 1);
         let dphi = PI / self.phi_bins as f64;
-        let phi = cos_phi(wi, wo).acos();
+        let phi = c.acos();
         let x = phi / dphi;
         let b = (x as usize).min(self.phi_bins - 1);
         let x = x - b as f64;
         let e = (h * self.mu_bins + k) * (self.phi_bins + 1) + b;
-        let cells = &self.cells[side as usize];
+        let cells = &self.cells[side];
         let density = |c: &CellDensity| c.edge[e] * (1.0 - x) + c.edge[e + 1] * x;
         let p_tab = density(&cells[j]) * (1.0 - t) + density(&cells[j + 1]) * t;
         (1.0 - COSINE_SHARE) * p_tab + COSINE_SHARE * wi.z.abs() / (2.0 * PI)
     }
 
     /// Draws `wi` from the table's density for `wo` (`uc` uniform, `u` for the cell).
-    fn sample_table(&self, wo: DVec3, uc: f64, u: [f64; 2]) -> Option<DVec3> {
+    fn sample_table(&self, wo: DVec3, wo_at: Place, uc: f64, u: [f64; 2]) -> Option<DVec3> {
         let side = Side::of(wo);
         if uc < COSINE_SHARE {
             let v = uc / COSINE_SHARE;
@@ -976,7 +1010,7 @@ impl SlabBsdf {
             return Some(DVec3::new(d.x, d.y, z * d.z));
         }
         let mut v = (uc - COSINE_SHARE) / (1.0 - COSINE_SHARE);
-        let (j, t) = locate(&self.mu, wo.z.abs());
+        let (j, t) = wo_at.at;
         let node = if v < 1.0 - t {
             v /= 1.0 - t;
             j
@@ -1018,7 +1052,13 @@ impl SlabBsdf {
 
     /// The continuous part of `f` (the table, clamped at 0, plus the analytic surface reflection).
     fn eval_all(&self, wi: DVec3, wo: DVec3) -> Rgb {
-        let table = self.eval_table(&self.table, wi, wo).map(|x| x.max(0.0));
+        self.eval_all_at(wi, wo, self.place(wi), self.place(wo), cos_phi(wi, wo))
+    }
+
+    /// [`SlabBsdf::eval_all`] with the directions placed among the nodes and
+    /// `c` the cosine of their azimuth difference.
+    fn eval_all_at(&self, wi: DVec3, wo: DVec3, wi_at: Place, wo_at: Place, c: f64) -> Rgb {
+        let table = self.eval_table_at(&self.table, wi_at, wo_at, c).map(|x| x.max(0.0));
         if wi.z * wo.z > 0.0 {
             table + Rgb::splat(self.paper.face_interface_reflection(Side::of(wi), wi, wo))
         } else {
@@ -1039,7 +1079,8 @@ impl Bsdf for SlabBsdf {
         if wo.z == 0.0 {
             return None;
         }
-        let weights = self.lobe_weights(wo);
+        let wo_at = self.place(wo);
+        let weights = self.lobe_weights(wo_at);
         let (_, rd, td, _) = weights;
         let probs = Self::probs_of(weights);
         let (lobe, start) = paperbsdf_core::bsdf::select_lobe(uc, &probs)?;
@@ -1064,15 +1105,23 @@ impl Bsdf for SlabBsdf {
                 });
             }
             0 => self.paper.sample_face_reflection(wo, u)?,
-            _ => self.sample_table(wo, v, u)?,
+            _ => self.sample_table(wo, wo_at, v, u)?,
         };
         if wi.z == 0.0 {
             return None;
         }
-        let pdf = self.pdf_given(&probs, wi, wo);
+        // The face's reflection and density at once (both 0 in transmission).
+        let c = cos_phi(wi, wo);
+        let (face_f, face_pdf) = self.paper.face_interface_reflection_and_pdf(Side::of(wo), wi, wo);
+        let mut pdf = probs[0] * face_pdf;
+        if probs[3] > 0.0 {
+            pdf += probs[3] * self.table_pdf(wi, wo_at, c);
+        }
         if pdf <= 0.0 {
             return None;
         }
+        let wi_at = self.place(wi);
+        let f = self.eval_table_at(&self.table, wi_at, wo_at, c).map(|x| x.max(0.0)) + Rgb::splat(face_f);
         let flags = if wi.z * wo.z > 0.0 {
             BsdfFlags::REFLECTION
                 | if lobe == 0 {
@@ -1083,19 +1132,21 @@ impl Bsdf for SlabBsdf {
         } else {
             BsdfFlags::TRANSMISSION | BsdfFlags::DIFFUSE
         };
-        Some(BsdfSample {
-            wi,
-            f: self.eval_all(wi, wo),
-            pdf,
-            flags,
-        })
+        Some(BsdfSample { wi, f, pdf, flags })
     }
 
     fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
         if wi.z == 0.0 || wo.z == 0.0 {
             return 0.0;
         }
-        self.pdf_given(&self.lobe_probs(wo), wi, wo)
+        let wo_at = self.place(wo);
+        self.pdf_given(
+            &Self::probs_of(self.lobe_weights(wo_at)),
+            wi,
+            wo,
+            wo_at,
+            cos_phi(wi, wo),
+        )
     }
 
     fn flags(&self) -> BsdfFlags {

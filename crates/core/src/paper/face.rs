@@ -623,6 +623,19 @@ impl Face {
         (r - a[coat] * b[coat]).max(0.0)
     }
 
+    /// `(f_r, pdf)`: [`Face::interface_reflection`] and [`Face::reflection_pdf`]
+    /// at once, sharing `D(h)` and the masking ([`Face::reflection_and_pdf`]).
+    #[inline]
+    pub fn interface_reflection_and_pdf(&self, wi: DVec3, wo: DVec3) -> (f64, f64) {
+        let (pi, po) = (TabPos::new(wi.z.min(1.0).sqrt()), TabPos::new(wo.z.min(1.0).sqrt()));
+        let (r, pdf) = self.reflection_and_pdf(wi, wo, pi, po);
+        let Some(coat) = self.coat_lobe else {
+            return (r, pdf);
+        };
+        let (a, b) = (self.lobe_node(pi), self.lobe_node(po));
+        ((r - a[coat] * b[coat]).max(0.0), pdf)
+    }
+
     /// Density of [`Face::sample_reflection`]: `pdf_visible(wo, h) / (4 |wo.h|)`.
     #[inline(always)]
     pub fn reflection_pdf(&self, wi: DVec3, wo: DVec3) -> f64 {

@@ -525,6 +525,17 @@ impl PaperBsdf {
         self.faces[side].interface_reflection(side.local(wi), side.local(wo))
     }
 
+    /// `(f_r, pdf)`: [`PaperBsdf::face_interface_reflection`] and
+    /// [`PaperBsdf::face_reflection_pdf`] of the face on `side` at once
+    /// (sharing the microfacet terms; for a sampler that needs both), both
+    /// zero unless `wi` and `wo` are on `side`.
+    pub fn face_interface_reflection_and_pdf(&self, side: Side, wi: DVec3, wo: DVec3) -> (f64, f64) {
+        if side.local(wi).z <= 0.0 || side.local(wo).z <= 0.0 {
+            return (0.0, 0.0);
+        }
+        self.faces[side].interface_reflection_and_pdf(side.local(wi), side.local(wo))
+    }
+
     /// Directional reflectance of [`PaperBsdf::face_interface_reflection`]
     /// for light from outside at cosine `mu` (for a coated front without the
     /// coating's returned light; [`PaperBsdf::face_reflectance`] otherwise).
