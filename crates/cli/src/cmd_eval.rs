@@ -12,7 +12,7 @@ use paperbsdf_io::models::load_model;
 /// Arguments of `paperbsdf eval`.
 #[derive(clap::Args, Debug)]
 pub struct EvalArgs {
-    /// Model name: rough-dielectric, paper, reduced-multilayer, lambert-glass, or measured (with --params FILE.bsdf, an RGL measured file).
+    /// Model name: rough-dielectric, paper, reduced-multilayer, slab (the same sheet as paper solved by adding-doubling), lambert-glass, or measured (with --params FILE.bsdf, an RGL measured file).
     #[arg(long)]
     pub model: String,
     /// Parameters: a JSON or TOML file, inline JSON (`'{"eta":1.5,...}'`), a FIT.json, or a preset (matte, luster, glossy); for `measured`, the `.bsdf` file.

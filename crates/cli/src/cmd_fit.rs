@@ -10,7 +10,15 @@ use paperbsdf_core::{Distribution, FaceScattering};
 use paperbsdf_fit::dataset::load_dataset;
 use paperbsdf_fit::measured::{directional_albedo, in_plane, sample_measured, PointFilter, Sampling};
 use paperbsdf_fit::models::candidates_with_faces;
-use paperbsdf_fit::{fit, fix_params, parse_fix, FitOptions, Kind, Point};
+use paperbsdf_fit::{fit, fix_params, parse_fix, refine_with_slab, FitModel, FitOptions, Kind, Point, RefineOptions};
+
+/// `--refine`: a model that refines the fit from its optimum.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Refine {
+    /// The same sheet solved by adding-doubling (`--model slab` elsewhere):
+    /// within about 2% of the exact random walk, thin sheets included.
+    Slab,
+}
 
 /// Arguments of `paperbsdf fit`.
 #[derive(clap::Args, Debug)]
@@ -18,7 +26,7 @@ pub struct FitArgs {
     /// Measurement files (CSV: kind,theta_i_deg,theta_o_deg or wi_*,wo_* columns; f or r,g,b; optional stderr or weight), or one measured RGL `.bsdf` file.
     #[arg(required = true)]
     pub data: Vec<String>,
-    /// Model: paper, lambert-glass or reduced-multilayer.
+    /// Model: paper, lambert-glass or reduced-multilayer (`slab` refines a paper fit: --refine slab).
     #[arg(long)]
     pub model: String,
     /// Paper thickness d in mm (not fitted); default: from the data's `# thickness:` or `# params:` header.
@@ -54,9 +62,18 @@ pub struct FitArgs {
     pub fix: Vec<String>,
     /// The model's own error (RMS log error) used for the uncertainty intervals of the report: a value
     /// fits "within the model's error" when its refitted error stays within sqrt(E0^2 + max(RMS, E0)^2),
-    /// E0 the fit's error. Default 0.05, the model's documented accuracy in reflection (docs/accuracy.md).
-    #[arg(long = "model-error", value_name = "RMS", default_value_t = paperbsdf_fit::report::MODEL_ERROR_RMS)]
-    pub model_error: f64,
+    /// E0 the fit's error. Default 0.05, paper's documented accuracy in reflection (docs/accuracy.md);
+    /// 0.02 for the slab refinement (docs/accuracy_slab.md).
+    #[arg(long = "model-error", value_name = "RMS", allow_hyphen_values = true)]
+    pub model_error: Option<f64>,
+    /// Refine the fit with a more accurate model from its optimum: `slab` (the same sheet solved by
+    /// adding-doubling; the same free parameters, bounds and --fix holds; a solve per evaluation,
+    /// about a minute or more). FIT.json is then the slab fit, with the paper fit under `refinement`.
+    #[arg(long, value_enum, ignore_case = true)]
+    pub refine: Option<Refine>,
+    /// Iteration limit (Jacobians, each one solve per free parameter, in parallel) of the --refine step.
+    #[arg(long = "refine-max-iter", value_name = "N", default_value_t = 40)]
+    pub refine_max_iter: usize,
     /// Linearised uncertainty intervals only (no profile refits: faster, but the intervals can be too narrow).
     #[arg(long = "no-profile")]
     pub no_profile: bool,
@@ -82,8 +99,22 @@ pub fn run(args: FitArgs) -> Result<()> {
     if args.samples == 0 || args.starts == 0 || args.max_iter == 0 {
         bail!("--samples, --starts and --max-iter must be at least 1");
     }
-    if !(args.model_error >= 0.0 && args.model_error.is_finite()) {
-        bail!("--model-error {} must be a finite RMS log error >= 0", args.model_error);
+    if let Some(e) = args.model_error {
+        if !(e >= 0.0 && e.is_finite()) {
+            bail!("--model-error {e} must be a finite RMS log error >= 0");
+        }
+    }
+    if args.refine_max_iter == 0 {
+        bail!("--refine-max-iter 0: the refinement needs at least 1 iteration");
+    }
+    if args.refine.is_some() {
+        match args.model.parse::<paperbsdf_core::models::ModelKind>() {
+            Ok(k) if k.is_slab() && k.is_fittable() => {}
+            _ => bail!(
+                "--refine slab refines a fit of --model paper or reduced-multilayer (the same sheet parameters), not --model {}",
+                args.model
+            ),
+        }
     }
     if let Some(out) = &args.out {
         // Before the fit, not after it (issue 16).
@@ -182,13 +213,54 @@ pub fn run(args: FitArgs) -> Result<()> {
         seed: args.seed,
         progress: true,
         report: paperbsdf_fit::report::ReportSettings {
-            model_error: args.model_error,
+            model_error: args.model_error.unwrap_or(paperbsdf_fit::report::MODEL_ERROR_RMS),
             profile: !args.no_profile,
             ..Default::default()
         },
         ..Default::default()
     };
     let out = fit(&ds.points, ds.channels, &cands, &opts)?;
+    let refined = match args.refine {
+        None => None,
+        Some(Refine::Slab) => {
+            println!(
+                "{} fit: rms_log_error {:.5} (extrapolation {}) in {:.1} s; refining with slab from its optimum",
+                out.model,
+                out.rms_log_error,
+                out.extrapolation_rms_log_error
+                    .map(|e| format!("{e:.5}"))
+                    .unwrap_or("none".into()),
+                out.seconds
+            );
+            let ropts = RefineOptions {
+                lm: paperbsdf_fit::optimize::LmSettings {
+                    max_iter: args.refine_max_iter,
+                    parallel_jacobian: true,
+                    ..Default::default()
+                },
+                fit_theta_i: fit_theta_i.clone(),
+                progress: true,
+                report: Some(paperbsdf_fit::report::ReportSettings {
+                    model_error: args.model_error.unwrap_or(paperbsdf_fit::refine::SLAB_MODEL_ERROR_RMS),
+                    profile: false,
+                    ..Default::default()
+                }),
+            };
+            let r = refine_with_slab(&ds.points, ds.channels, &cands, &out, &ropts)?;
+            println!(
+                "slab at the {} optimum: rms_log_error {:.5}; refined: {:.5} in {} solves, {:.1} s{}",
+                r.from_model,
+                r.start_rms_log_error,
+                r.outcome.rms_log_error,
+                r.outcome.evaluations,
+                r.outcome.seconds,
+                if r.converged { "" } else { " (not converged)" }
+            );
+            Some(r)
+        }
+    };
+    let paper_out = out;
+    let out = refined.as_ref().map_or(&paper_out, |r| &r.outcome);
     println!("model: {} ({})", out.model, out.variant);
     println!("params: {}", out.params);
     println!(
@@ -209,7 +281,10 @@ pub fn run(args: FitArgs) -> Result<()> {
         );
     }
     // In-plane and out-of-plane errors, on the fitted and the extrapolation points.
-    let model = cands[out.variant_index].build(&out.x)?;
+    let model = match &refined {
+        Some(_) => paperbsdf_fit::models::SlabFit::new(cands[out.variant_index].as_ref())?.build(&out.x)?,
+        None => cands[out.variant_index].build(&out.x)?,
+    };
     let (fitted, extra) = paperbsdf_fit::fitter::split_points(&ds.points, fit_theta_i.as_deref());
     fn part<'a>(pts: &[&'a Point], plane: bool) -> Vec<&'a Point> {
         pts.iter().copied().filter(|p| in_plane(p) == plane).collect()
@@ -286,7 +361,10 @@ pub fn run(args: FitArgs) -> Result<()> {
     }
     println!("seconds: {:.2}", out.seconds);
     if let Some(path) = &args.out {
-        let mut json = out.to_json(&ds.origins, fit_theta_i.as_deref());
+        let mut json = match &refined {
+            Some(r) => r.to_json(&ds.origins, fit_theta_i.as_deref()),
+            None => out.to_json(&ds.origins, fit_theta_i.as_deref()),
+        };
         let obj = json.as_object_mut().expect("FIT.json is an object");
         obj.insert("errors_by_plane".into(), serde_json::Value::Object(plane_json));
         obj.insert(

@@ -20,7 +20,7 @@ pub struct MeasureArgs {
     /// Parameters: a JSON or TOML file, or inline JSON.
     #[arg(long)]
     pub params: String,
-    /// Model name: paper, reduced-multilayer, lambert-glass, rough-dielectric.
+    /// Model name: paper, reduced-multilayer, slab, lambert-glass, rough-dielectric.
     #[arg(long, default_value = "paper")]
     pub model: String,
     /// Print JSON (keys as in docs/paper_metrics.md) instead of a table.

@@ -148,4 +148,23 @@ pub enum FitError {
     /// `--fix` of every parameter.
     #[error("--fix holds every parameter: nothing is left to fit")]
     FixAll,
+    /// The `slab` model's solver refused a sheet for a reason other than a
+    /// parameter range (a parameter outside its range is [`FitError::Params`]).
+    #[error("the slab model's solver: {0}")]
+    Slab(paperbsdf_slab::SlabError),
+    /// A refinement with `slab` asked of a model whose parameters are not the sheet's.
+    #[error("--refine slab refines a fit of `paper` or `reduced-multilayer` (the same sheet parameters); `{model}` has other parameters")]
+    RefineFrom {
+        /// The model of the fit that was to be refined.
+        model: String,
+    },
+}
+
+impl From<paperbsdf_slab::SlabError> for FitError {
+    fn from(e: paperbsdf_slab::SlabError) -> FitError {
+        match e {
+            paperbsdf_slab::SlabError::Param(p) => FitError::Params(p),
+            other => FitError::Slab(other),
+        }
+    }
 }

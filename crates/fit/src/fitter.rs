@@ -345,36 +345,7 @@ pub fn fit(
     let mut warnings = Vec::new();
     if let Some(id) = &ident {
         evaluations += id.evaluations;
-        for p in &id.params {
-            let fix = p.name.split('[').next().unwrap_or(&p.name);
-            if p.on_bound {
-                warnings.push(format!(
-                    "{} = {:.6} ended on a bound of its search range [{}, {}]: the data push it beyond what the model allows; its value is not a measurement (hold it with --fix {fix}=VALUE)",
-                    p.name, p.value, p.bounds[0], p.bounds[1]
-                ));
-            } else if !p.determined {
-                let how = if p.interval_width_unit.is_finite() {
-                    format!(
-                        "any value from {:.4e} to {:.4e} ({:.0}% of its search range{}) fits within the model's own error, RMS log error {:.3}",
-                        p.interval[0],
-                        p.interval[1],
-                        100.0 * p.interval_width_unit,
-                        if p.interval_method == crate::report::IntervalMethod::Linear {
-                            ", linearised"
-                        } else {
-                            ""
-                        },
-                        id.interval_level
-                    )
-                } else {
-                    "no constraint at all: it trades off exactly against other parameters".to_string()
-                };
-                warnings.push(format!(
-                    "{} = {:.6} is not determined by the data: {how}; hold it at a plausible value with --fix {fix}=VALUE",
-                    p.name, p.value
-                ));
-            }
-        }
+        warnings = report_warnings(id);
     }
     Ok(FitOutcome {
         model: c.model_name().to_string(),
@@ -393,6 +364,43 @@ pub fn fit(
         identifiability: ident,
         warnings,
     })
+}
+
+/// The warnings of an identifiability report: parameters on a bound of their
+/// search range and parameters the data do not determine.
+pub(crate) fn report_warnings(id: &Identifiability) -> Vec<String> {
+    let mut warnings = Vec::new();
+    for p in &id.params {
+        let fix = p.name.split('[').next().unwrap_or(&p.name);
+        if p.on_bound {
+            warnings.push(format!(
+                "{} = {:.6} ended on a bound of its search range [{}, {}]: the data push it beyond what the model allows; its value is not a measurement (hold it with --fix {fix}=VALUE)",
+                p.name, p.value, p.bounds[0], p.bounds[1]
+            ));
+        } else if !p.determined {
+            let how = if p.interval_width_unit.is_finite() {
+                format!(
+                    "any value from {:.4e} to {:.4e} ({:.0}% of its search range{}) fits within the model's own error, RMS log error {:.3}",
+                    p.interval[0],
+                    p.interval[1],
+                    100.0 * p.interval_width_unit,
+                    if p.interval_method == crate::report::IntervalMethod::Linear {
+                        ", linearised"
+                    } else {
+                        ""
+                    },
+                    id.interval_level
+                )
+            } else {
+                "no constraint at all: it trades off exactly against other parameters".to_string()
+            };
+            warnings.push(format!(
+                "{} = {:.6} is not determined by the data: {how}; hold it at a plausible value with --fix {fix}=VALUE",
+                p.name, p.value
+            ));
+        }
+    }
+    warnings
 }
 
 impl FitOutcome {

@@ -13,6 +13,8 @@
 //! * [`measured`]: sampling a measured `.bsdf` file, goniometer filters, measured albedo;
 //! * [`report`]: what the data determine (each parameter's interval within the model's
 //!   own error, from profile refits; noise standard errors; bounds) and degenerate-data checks;
+//! * [`refine`]: a `paper` fit refined with the model `slab` (the same sheet
+//!   solved by adding-doubling, `paperbsdf_slab`);
 //! * [`error`]: the crate's error type [`FitError`];
 //! * [`fitter`]: global multi-start search plus local refinement, scoring of
 //!   fitted and extrapolation points.
@@ -28,9 +30,11 @@ pub mod model;
 pub mod models;
 pub mod objective;
 pub mod optimize;
+pub mod refine;
 pub mod report;
 
 pub use error::FitError;
 pub use fitter::{fit, FitOptions, FitOutcome, GroupError};
 pub use measurement::{parse_measurement, read_measurement, Kind, Measurement, MeasurementError, Point};
 pub use model::{fix_params, parse_fix, ComponentModel, FitModel, ParamSpec, Scale, Subset};
+pub use refine::{refine_with_slab, RefineOptions, Refinement};

@@ -1,7 +1,9 @@
 //! The models the fitter knows, as [`FitModel`]s: `paper` (the Paper BSDF,
 //! docs/design.md section 4), `reduced-multilayer` (the Paper BSDF without the
 //! attenuation term, section 4.7) and `lambert-glass` (Lambertian reflection
-//! and transmission plus a rough dielectric, section 4.7).
+//! and transmission plus a rough dielectric, section 4.7); and `slab` (the
+//! same sheet as `paper` solved by adding-doubling, [`SlabFit`]), which
+//! refines a `paper` fit rather than being searched.
 //!
 //! Search bounds (Table 2 of the supplement, made finite):
 //!
@@ -154,13 +156,19 @@ impl FitModel for PaperFit {
         };
         Ok(kind.build(&ModelParams::Slab(self.params(x)))?)
     }
+    /// The parameter file: every parameter; `face_scattering` only when it is
+    /// not the default `multiple` (a file without it means `multiple`).
     fn params_json(&self, x: &[f64]) -> serde_json::Value {
         let p = self.params(x);
-        serde_json::json!({
+        let mut j = serde_json::json!({
             "d": p.d, "sigma_a": colour_json(&p.sigma_a), "sigma_s": colour_json(&p.sigma_s),
             "g_f": p.g_f, "g_b": p.g_b, "w_b": p.w_b, "eta_f": p.eta_f, "eta_b": p.eta_b,
             "m_f": p.m_f, "m_b": p.m_b, "dist_f": p.dist_f.name(), "dist_b": p.dist_b.name(),
-        })
+        });
+        if p.face_scattering != FaceScattering::default() {
+            j["face_scattering"] = p.face_scattering.name().into();
+        }
+        j
     }
 }
 
@@ -261,12 +269,66 @@ pub fn candidates_with_faces(
     }
 }
 
-/// Builds model `name` from a parameter set (the `params` of a FIT.json).
+/// The model `slab` (the sheet solved by adding-doubling, `paperbsdf_slab`)
+/// over the parameters of a `paper` or `reduced-multilayer` fit model: the
+/// same free parameters, bounds, scales and held values (it reads the sheet
+/// from the paper model's parameter file), each build a solve
+/// ([`paperbsdf_slab::SlabBsdf::new`]). The fitter refines with it
+/// ([`crate::refine`]); it is not searched globally (a solve costs about as
+/// much as a thousand Paper BSDF builds).
+pub struct SlabFit<'a> {
+    paper: &'a dyn FitModel,
+}
+
+impl<'a> SlabFit<'a> {
+    /// `slab` over the parameters of `paper`; an error if `paper`'s
+    /// parameters are not the sheet's (`lambert-glass`).
+    pub fn new(paper: &'a dyn FitModel) -> Result<SlabFit<'a>, FitError> {
+        match paper.model_name().parse::<ModelKind>() {
+            Ok(k) if k.is_slab() && k != ModelKind::Slab => Ok(SlabFit { paper }),
+            _ => Err(FitError::RefineFrom {
+                model: paper.model_name().to_string(),
+            }),
+        }
+    }
+    /// The sheet of values `x`.
+    pub fn params(&self, x: &[f64]) -> Result<PaperParams, FitError> {
+        serde_json::from_value(self.paper.params_json(x)).map_err(|source| FitError::ParamsJson {
+            model: ModelKind::Slab.name().to_string(),
+            source,
+        })
+    }
+}
+
+impl FitModel for SlabFit<'_> {
+    fn model_name(&self) -> &str {
+        ModelKind::Slab.name()
+    }
+    fn variant(&self) -> String {
+        self.paper.variant()
+    }
+    fn specs(&self) -> &[ParamSpec] {
+        self.paper.specs()
+    }
+    fn build(&self, x: &[f64]) -> Result<Box<dyn ComponentModel>, FitError> {
+        Ok(Box::new(paperbsdf_slab::SlabBsdf::new(&self.params(x)?)?))
+    }
+    fn params_json(&self, x: &[f64]) -> serde_json::Value {
+        self.paper.params_json(x)
+    }
+}
+
+/// Builds model `name` from a parameter set (the `params` of a FIT.json):
+/// the fittable models and `slab` (the result of `fit --refine slab`).
 pub fn build_from_params(name: &str, params: &serde_json::Value) -> Result<Box<dyn ComponentModel>, FitError> {
     let json_error = |source| FitError::ParamsJson {
         model: name.to_string(),
         source,
     };
+    if name.parse::<ModelKind>() == Ok(ModelKind::Slab) {
+        let p: PaperParams = serde_json::from_value(params.clone()).map_err(json_error)?;
+        return Ok(Box::new(paperbsdf_slab::SlabBsdf::new(&p)?));
+    }
     let kind = fittable(name)?;
     let typed = if kind.is_slab() {
         ModelParams::Slab(serde_json::from_value(params.clone()).map_err(json_error)?)

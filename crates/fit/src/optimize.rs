@@ -61,6 +61,10 @@ pub struct LmSettings {
     /// boundary integrals are interpolated from tables, updated Jacobians made
     /// the refinement crawl near the minimum).
     pub broyden_steps: usize,
+    /// Evaluate the finite-difference Jacobian's columns in parallel (rayon):
+    /// for models whose build dominates (the `slab` model's solve), where the
+    /// refinement itself is one search and has no other parallelism.
+    pub parallel_jacobian: bool,
 }
 
 impl Default for LmSettings {
@@ -74,6 +78,7 @@ impl Default for LmSettings {
             broyden_steps: 0,
             stall_window: 10,
             stall_rtol: 1e-2,
+            parallel_jacobian: false,
         }
     }
 }
@@ -139,7 +144,7 @@ pub fn solve(mut a: Vec<f64>, mut b: Vec<f64>, n: usize) -> Option<Vec<f64>> {
 /// fails, and before convergence is declared (every stop criterion is checked
 /// with a finite-difference Jacobian).
 pub fn levenberg_marquardt(
-    resid: &dyn Fn(&[f64], &mut [f64]) -> bool,
+    resid: &(dyn Fn(&[f64], &mut [f64]) -> bool + Sync),
     u0: &[f64],
     m: usize,
     s: &LmSettings,
@@ -169,14 +174,24 @@ pub fn levenberg_marquardt(
         iter += 1;
         if !fresh && updates >= s.broyden_steps {
             // Forward-difference Jacobian (backward at the upper bound).
-            for j in 0..n {
+            let column = |j: usize| -> Vec<f64> {
                 let h = if u[j] + s.fd_step <= 1.0 { s.fd_step } else { -s.fd_step };
                 let mut up = u.clone();
                 up[j] += h;
-                evals += 1;
-                let ok = resid(&up, &mut rt);
+                let mut rj = vec![0.0; m];
+                let ok = resid(&up, &mut rj);
+                (0..m).map(|i| if ok { (rj[i] - r[i]) / h } else { 0.0 }).collect()
+            };
+            let columns: Vec<Vec<f64>> = if s.parallel_jacobian {
+                use rayon::prelude::*;
+                (0..n).into_par_iter().map(column).collect()
+            } else {
+                (0..n).map(column).collect()
+            };
+            evals += n;
+            for (j, col) in columns.iter().enumerate() {
                 for i in 0..m {
-                    jac[i * n + j] = if ok { (rt[i] - r[i]) / h } else { 0.0 };
+                    jac[i * n + j] = col[i];
                 }
             }
             fresh = true;
@@ -353,6 +368,30 @@ mod tests {
             "{:?}",
             r.u
         );
+    }
+
+    #[test]
+    fn parallel_jacobian_takes_the_same_path() {
+        // The columns are the same numbers whichever thread computes them, so
+        // the iterates, the cost and the evaluation count are identical.
+        let f = |u: &[f64], out: &mut [f64]| {
+            let (x, y, z) = (4.0 * u[0] - 2.0, 4.0 * u[1] - 2.0, u[2]);
+            out[0] = 10.0 * (y - x * x);
+            out[1] = 1.0 - x;
+            out[2] = (z - 0.3) * (1.0 + x * x);
+            true
+        };
+        let serial = levenberg_marquardt(&f, &[0.1, 0.9, 0.8], 3, &LmSettings::default());
+        let par = LmSettings {
+            parallel_jacobian: true,
+            ..LmSettings::default()
+        };
+        let parallel = levenberg_marquardt(&f, &[0.1, 0.9, 0.8], 3, &par);
+        assert!(serial.stop.converged(), "{:?}", serial.stop);
+        assert_eq!(serial.u, parallel.u);
+        assert_eq!(serial.cost, parallel.cost);
+        assert_eq!(serial.evaluations, parallel.evaluations);
+        assert!((serial.u[2] - 0.3).abs() < 1e-6, "{:?}", serial.u);
     }
 
     #[test]

@@ -216,16 +216,23 @@ pub fn identifiability(
     let cost: f64 = r0.iter().map(|x| x * x).sum();
     let mut j = DMatrix::<f64>::zeros(n, p);
     let h = 1e-4;
-    for k in 0..p {
-        // central difference, one-sided at the box's ends
-        let (lo, hi) = ((u[k] - h).max(0.0), (u[k] + h).min(1.0));
-        let mut ul = u.to_vec();
-        ul[k] = lo;
-        let mut uh = u.to_vec();
-        uh[k] = hi;
-        let (rl, rh) = (resid(&ul)?, resid(&uh)?);
+    // Central differences, one-sided at the box's ends; the columns in parallel.
+    let columns: Vec<Option<Vec<f64>>> = (0..p)
+        .into_par_iter()
+        .map(|k| {
+            let (lo, hi) = ((u[k] - h).max(0.0), (u[k] + h).min(1.0));
+            let mut ul = u.to_vec();
+            ul[k] = lo;
+            let mut uh = u.to_vec();
+            uh[k] = hi;
+            let (rl, rh) = (resid(&ul)?, resid(&uh)?);
+            Some((0..n).map(|i| (rh[i] - rl[i]) / (hi - lo)).collect())
+        })
+        .collect();
+    for (k, col) in columns.into_iter().enumerate() {
+        let col = col?;
         for i in 0..n {
-            j[(i, k)] = (rh[i] - rl[i]) / (hi - lo);
+            j[(i, k)] = col[i];
         }
     }
     let svd = j.clone().svd(false, true);
