@@ -545,9 +545,13 @@ fn simulate<'py>(
 }
 
 /// Fits model `model` to the measurement files `data` (`paperbsdf fit`);
-/// returns the JSON text of the fit (the CLI's `--out` file).
+/// returns the JSON text of the fit (the CLI's `--out` file). `fix` holds
+/// parameters (`--fix NAME=VALUE`), `face_scattering` is `multiple` or
+/// `single`, `refine` = `slab` refines the fit with the model `slab`
+/// (`--refine slab`, at most `refine_max_iter` iterations).
 #[pyfunction]
-#[pyo3(signature = (data, model, thickness, fit_theta_i, dists, samples, starts, max_iter, seed))]
+#[pyo3(signature = (data, model, thickness, fit_theta_i, dists, samples, starts, max_iter, seed,
+                    fix = Vec::new(), face_scattering = "multiple", refine = None, refine_max_iter = 40))]
 #[allow(clippy::too_many_arguments)]
 fn fit(
     py: Python<'_>,
@@ -560,9 +564,41 @@ fn fit(
     starts: usize,
     max_iter: usize,
     seed: u64,
+    fix: Vec<(String, f64)>,
+    face_scattering: &str,
+    refine: Option<String>,
+    refine_max_iter: usize,
 ) -> PyResult<String> {
-    if samples == 0 || starts == 0 || max_iter == 0 {
-        return Err(value_error("samples, starts and max_iter must be at least 1"));
+    if samples == 0 || starts == 0 || max_iter == 0 || refine_max_iter == 0 {
+        return Err(value_error(
+            "samples, starts, max_iter and refine_max_iter must be at least 1",
+        ));
+    }
+    let faces: paperbsdf_core::FaceScattering = face_scattering
+        .parse()
+        .map_err(|e: paperbsdf_core::ParamError| value_error(e.to_string()))?;
+    match refine.as_deref() {
+        None | Some("slab") => {}
+        Some(other) => {
+            return Err(value_error(format!(
+                "refine: `{other}` is not a model that refines a fit (expected \"slab\" or None)"
+            )))
+        }
+    }
+    if refine.is_some() {
+        match model.parse::<paperbsdf_core::models::ModelKind>() {
+            Ok(k) if k.is_slab() && k.is_fittable() => {}
+            _ => {
+                return Err(value_error(format!(
+                    "refine=\"slab\" refines a fit of model paper or reduced-multilayer (the same sheet parameters), not {model}"
+                )))
+            }
+        }
+    }
+    for (name, v) in &fix {
+        if !v.is_finite() {
+            return Err(value_error(format!("fix: {name} = {v}: the value must be finite")));
+        }
     }
     let dists = dists
         .iter()
@@ -576,8 +612,10 @@ fn fit(
     let fit_error = |e: paperbsdf_fit::FitError| value_error(e.to_string());
     py.detach(move || -> PyResult<String> {
         let ds = paperbsdf_fit::dataset::load_dataset(&data, thickness).map_err(fit_error)?;
-        let cands = paperbsdf_fit::models::candidates(&model, ds.thickness, ds.channels == 3, Some(&dists))
-            .map_err(fit_error)?;
+        let cands =
+            paperbsdf_fit::models::candidates_with_faces(&model, ds.thickness, ds.channels == 3, Some(&dists), faces)
+                .map_err(fit_error)?;
+        let cands = paperbsdf_fit::fix_params(cands, &fix).map_err(fit_error)?;
         let opts = paperbsdf_fit::FitOptions {
             global_samples: samples,
             local_starts: starts,
@@ -591,7 +629,22 @@ fn fit(
             ..Default::default()
         };
         let out = paperbsdf_fit::fit(&ds.points, ds.channels, &cands, &opts).map_err(fit_error)?;
-        let json = out.to_json(&ds.origins, fit_theta_i.as_deref());
+        let json = if refine.is_some() {
+            let ropts = paperbsdf_fit::RefineOptions {
+                lm: paperbsdf_fit::optimize::LmSettings {
+                    max_iter: refine_max_iter,
+                    parallel_jacobian: true,
+                    ..Default::default()
+                },
+                fit_theta_i: fit_theta_i.clone(),
+                ..Default::default()
+            };
+            paperbsdf_fit::refine_with_slab(&ds.points, ds.channels, &cands, &out, &ropts)
+                .map_err(fit_error)?
+                .to_json(&ds.origins, fit_theta_i.as_deref())
+        } else {
+            out.to_json(&ds.origins, fit_theta_i.as_deref())
+        };
         serde_json::to_string(&json).map_err(|e| value_error(e.to_string()))
     })
 }

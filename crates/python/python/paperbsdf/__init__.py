@@ -259,11 +259,20 @@ def fit(
     starts: int = 16,
     max_iter: int = 500,
     seed: int = 1,
+    fix: Mapping[str, float] | None = None,
+    face_scattering: str = "multiple",
+    refine: str | None = None,
+    refine_max_iter: int = 40,
 ) -> dict:
     """Fits ``model`` (``paper``, ``lambert-glass``, ``reduced-multilayer``) to
     measurement files (``paperbsdf fit``): CSV with ``kind,theta_i_deg,theta_o_deg``
     or ``wi_*,wo_*`` columns and ``f`` or ``r,g,b``. ``fit_theta_i`` lists the
     incident angles fitted; points at other angles are extrapolation points.
+    ``fix`` holds parameters at values (``{"eta_b": 1.5}``, the CLI's ``--fix``);
+    ``face_scattering`` is ``"multiple"`` or ``"single"`` (Walter's faces).
+    ``refine="slab"`` refines the fit with the model ``slab`` from its optimum
+    (the CLI's ``--refine slab``: a solve per evaluation, minutes; the result's
+    ``model`` is ``slab``, the first fit is under ``refinement``).
     Returns the CLI's fit JSON as a dict (``model``, ``params``, ``rms_log_error``,
     ``extrapolation_rms_log_error``, ``errors``, ...)."""
     if isinstance(data, (str, os.PathLike)):
@@ -273,5 +282,7 @@ def fit(
         paths, model, None if thickness is None else float(thickness),
         None if fit_theta_i is None else [float(t) for t in fit_theta_i],
         [str(d) for d in dists], int(samples), int(starts), int(max_iter), int(seed),
+        [(str(k), float(v)) for k, v in (fix or {}).items()], str(face_scattering),
+        None if refine is None else str(refine), int(refine_max_iter),
     )
     return json.loads(text)
