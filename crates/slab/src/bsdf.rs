@@ -1044,7 +1044,8 @@ impl SlabBsdf {
         // wo's azimuth (reference +x at normal), then pi + phi from it.
         let so = (wo.x * wo.x + wo.y * wo.y).sqrt();
         let (co, sn) = if so < 1e-12 { (1.0, 0.0) } else { (wo.x / so, wo.y / so) };
-        let (cp, sp) = (-phi.cos(), -phi.sin());
+        let (sp, cp) = phi.sin_cos();
+        let (cp, sp) = (-cp, -sp);
         let (x, y) = (co * cp - sn * sp, sn * cp + co * sp);
         let z = if h == 0 { side.sign() } else { -side.sign() };
         Some(DVec3::new(s * x, s * y, z * mu))
