@@ -144,38 +144,25 @@ fn refine_slab_writes_a_slab_fit_that_eval_reads() {
 #[test]
 fn refine_bad_input_is_a_clean_error() {
     let data = "data/matte.csv";
-    fails_with(
-        &["fit", data, "--model", "lambert-glass", "--refine", "slab"],
+    let fit_fails = |extra: &[&str], parts: &[&str]| {
+        let mut args = vec!["fit", data];
+        args.extend(extra);
+        fails_with(&args, parts)
+    };
+    fit_fails(
+        &["--model", "lambert-glass", "--refine", "slab"],
         &["--refine slab", "lambert-glass"],
     );
-    fails_with(
-        &[
-            "fit",
-            data,
-            "--model",
-            "paper",
-            "--refine",
-            "slab",
-            "--refine-max-iter",
-            "0",
-        ],
+    fit_fails(
+        &["--model", "paper", "--refine", "slab", "--refine-max-iter", "0"],
         &["--refine-max-iter 0"],
+    );
+    fit_fails(
+        &["--model", "paper", "--refine", "slab", "--model-error", "-1"],
+        &["--model-error -1"],
     );
     let o = support::output(&["fit", data, "--model", "paper", "--refine", "glass"]);
     let err = support::text(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("invalid value 'glass'") && err.contains("slab"), "{err}");
-    fails_with(
-        &[
-            "fit",
-            data,
-            "--model",
-            "paper",
-            "--refine",
-            "slab",
-            "--model-error",
-            "-1",
-        ],
-        &["--model-error -1"],
-    );
 }

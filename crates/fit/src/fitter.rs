@@ -160,7 +160,7 @@ pub fn fit(
     opts: &FitOptions,
 ) -> Result<FitOutcome, FitError> {
     let t0 = std::time::Instant::now();
-    let (fitted, extra) = split_points(points, opts.fit_theta_i.as_deref());
+    let (fitted, _) = split_points(points, opts.fit_theta_i.as_deref());
     if fitted.is_empty() {
         let why = match &opts.fit_theta_i {
             Some(l) => format!(": no point has an incident angle in the fitted list {l:?}"),
@@ -331,8 +331,7 @@ pub fn fit(
     }
     let x = c.values(&best.u);
     let model = c.build(&x).map_err(|e| FitError::NoValidStart(e.to_string()))?;
-    let (rms, rms_u) = rms_log_error(model.as_ref(), &fitted, channels).unwrap();
-    let extra_rms = rms_log_error(model.as_ref(), &extra, channels).map(|e| e.0);
+    let (rms, _) = rms_log_error(model.as_ref(), &fitted, channels).unwrap();
     if rms.is_nan() || rms > MEANINGLESS_RMS {
         return Err(FitError::Meaningless {
             variant: c.variant(),
@@ -347,23 +346,18 @@ pub fn fit(
         evaluations += id.evaluations;
         warnings = report_warnings(id);
     }
-    Ok(FitOutcome {
-        model: c.model_name().to_string(),
-        variant: c.variant(),
-        variant_index: ci,
-        params: c.params_json(&x),
+    Ok(FitOutcome::scored(
+        c,
+        ci,
         x,
-        rms_log_error: rms,
-        rms_log_error_unweighted: rms_u,
-        extrapolation_rms_log_error: extra_rms,
-        per_group: group_errors(model.as_ref(), points, opts.fit_theta_i.as_deref(), channels),
-        counts: (fitted.len(), extra.len()),
-        evaluations,
-        seconds: t0.elapsed().as_secs_f64(),
-        stop: best.stop,
-        identifiability: ident,
+        model.as_ref(),
+        points,
+        opts.fit_theta_i.as_deref(),
+        channels,
+        (evaluations, t0.elapsed().as_secs_f64(), best.stop),
+        ident,
         warnings,
-    })
+    ))
 }
 
 /// The warnings of an identifiability report: parameters on a bound of their
@@ -404,6 +398,44 @@ pub(crate) fn report_warnings(id: &Identifiability) -> Vec<String> {
 }
 
 impl FitOutcome {
+    /// The outcome of variant `variant_index`, `c`, at values `x` (`model`
+    /// its build): its errors on the fitted and extrapolation `points` (split
+    /// by `fit_theta_i`) and per incident angle and kind, with the run's
+    /// `(evaluations, seconds, stop)`, report and warnings.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn scored(
+        c: &dyn FitModel,
+        variant_index: usize,
+        x: Vec<f64>,
+        model: &dyn ComponentModel,
+        points: &[Point],
+        fit_theta_i: Option<&[f64]>,
+        channels: usize,
+        (evaluations, seconds, stop): (usize, f64, Stop),
+        identifiability: Option<Identifiability>,
+        warnings: Vec<String>,
+    ) -> FitOutcome {
+        let (fitted, extra) = split_points(points, fit_theta_i);
+        let (rms, rms_u) = rms_log_error(model, &fitted, channels).unwrap_or((f64::NAN, f64::NAN));
+        FitOutcome {
+            model: c.model_name().to_string(),
+            variant: c.variant(),
+            variant_index,
+            params: c.params_json(&x),
+            x,
+            rms_log_error: rms,
+            rms_log_error_unweighted: rms_u,
+            extrapolation_rms_log_error: rms_log_error(model, &extra, channels).map(|e| e.0),
+            per_group: group_errors(model, points, fit_theta_i, channels),
+            counts: (fitted.len(), extra.len()),
+            evaluations,
+            seconds,
+            stop,
+            identifiability,
+            warnings,
+        }
+    }
+
     /// The FIT.json document: `model`, `params`, `rms_log_error`,
     /// `extrapolation_rms_log_error` (null when none), errors per incident angle
     /// and kind, `seconds`, and how the fit went.

@@ -20,7 +20,7 @@
 //! accuracy against the simulator.
 
 use crate::error::FitError;
-use crate::fitter::{group_errors, report_warnings, split_points, FitOutcome};
+use crate::fitter::{report_warnings, split_points, FitOutcome};
 use crate::model::FitModel;
 use crate::models::SlabFit;
 use crate::objective::{residuals, rms_log_error, sqrt_weights};
@@ -122,7 +122,7 @@ pub fn refine_with_slab(
             ),
         });
     }
-    let (fitted, extra) = split_points(points, opts.fit_theta_i.as_deref());
+    let (fitted, _) = split_points(points, opts.fit_theta_i.as_deref());
     if fitted.is_empty() {
         return Err(FitError::NoPoints(String::new()));
     }
@@ -173,8 +173,7 @@ pub fn refine_with_slab(
     let mut evaluations = r.evaluations + 1;
     let x = slab.values(&r.u);
     let model = slab.build(&x)?;
-    let (rms, rms_u) = rms_log_error(model.as_ref(), &fitted, channels).expect("points");
-    let extra_rms = rms_log_error(model.as_ref(), &extra, channels).map(|e| e.0);
+    let (rms, _) = rms_log_error(model.as_ref(), &fitted, channels).expect("points");
     let ident = opts.report.as_ref().and_then(|rs| {
         let rs = ReportSettings { profile: false, ..*rs };
         identifiability(&slab, &r.u, &fitted, &sw, channels, &rs)
@@ -191,23 +190,18 @@ pub fn refine_with_slab(
             r.iterations
         ));
     }
-    let outcome = FitOutcome {
-        model: slab.model_name().to_string(),
-        variant: slab.variant(),
-        variant_index: from.variant_index,
-        params: slab.params_json(&x),
+    let outcome = FitOutcome::scored(
+        &slab,
+        from.variant_index,
         x,
-        rms_log_error: rms,
-        rms_log_error_unweighted: rms_u,
-        extrapolation_rms_log_error: extra_rms,
-        per_group: group_errors(model.as_ref(), points, opts.fit_theta_i.as_deref(), channels),
-        counts: (fitted.len(), extra.len()),
-        evaluations,
-        seconds: t0.elapsed().as_secs_f64(),
-        stop: r.stop,
-        identifiability: ident,
+        model.as_ref(),
+        points,
+        opts.fit_theta_i.as_deref(),
+        channels,
+        (evaluations, t0.elapsed().as_secs_f64(), r.stop),
+        ident,
         warnings,
-    };
+    );
     Ok(Refinement {
         outcome,
         from_model: from.model.clone(),
