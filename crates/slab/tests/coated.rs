@@ -66,12 +66,15 @@
 //! The solver's totals must equal these to 1e-12, and the front face's
 //! first reflection (`Prepared::faces[0]`'s `r_top`) must be `F_1` alone.
 
+mod support;
+
+use support::{layer_asymmetry, simulated_totals};
 use nalgebra::DMatrix;
 use paperbsdf_core::fresnel::fresnel_dielectric;
 use paperbsdf_core::phase::TwoLobeHg;
 use paperbsdf_core::{Colour, DVec3, Distribution, FaceScattering, PaperParams};
-use paperbsdf_sim::{simulate_totals, Incidence, SimConfig, Slab};
-use paperbsdf_slab::{smooth_boundary, Discretisation, Face, Grid, Layer, Medium, Side, SlabError, SlabSpec, Solution};
+use paperbsdf_sim::Slab;
+use paperbsdf_slab::{smooth_boundary, Discretisation, Face, Grid, Medium, Side, SlabError, SlabSpec, Solution};
 use std::time::Instant;
 
 const PAPER_PHASE: TwoLobeHg = TwoLobeHg {
@@ -167,21 +170,6 @@ fn non_absorbing_coated_sheets_conserve_energy() {
         start.elapsed().as_secs_f64()
     );
     assert!(worst < 1e-4, "{worst}");
-}
-
-/// Largest asymmetry of `W_a K_ab` against `(W_b K_ba)^T`, relative to the largest entry.
-fn asymmetry(wa: &[f64], kab: &DMatrix<f64>, wb: &[f64], kba: &DMatrix<f64>) -> f64 {
-    let a = DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(wa)) * kab;
-    let b = DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(wb)) * kba;
-    let diff = (&a - b.transpose()).amax();
-    diff / a.amax().max(b.amax()).max(1e-300)
-}
-
-fn layer_asymmetry(l: &Layer, top: &Grid, bot: &Grid) -> f64 {
-    let (wt, wb) = (top.reciprocity_weights(), bot.reciprocity_weights());
-    asymmetry(&wt, &l.r_top, &wt, &l.r_top)
-        .max(asymmetry(&wb, &l.r_bot, &wb, &l.r_bot))
-        .max(asymmetry(&wb, &l.t_down, &wt, &l.t_up))
 }
 
 #[test]
@@ -414,15 +402,7 @@ fn coated_totals_agree_with_the_simulator() {
                 let z = if side == Side::Front { mu } else { -mu };
                 let wi = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, z);
                 let (r, t) = sol.totals_collimated(side, j);
-                let cfg = SimConfig {
-                    samples: walks,
-                    batches: 16,
-                    seed: 29 + j as u64,
-                    ..Default::default()
-                };
-                let s = simulate_totals(&slab, Incidence::Collimated(wi), &cfg).unwrap();
-                let (sr, se_r) = (s.reflectance.mean.0[0], s.reflectance.stderr.0[0]);
-                let (st, se_t) = (s.transmittance.mean.0[0], s.transmittance.stderr.0[0]);
+                let (sr, se_r, st, se_t) = simulated_totals(&slab, wi, walks, 29 + j as u64);
                 println!(
                     "eta_f {eta_f} eta_b {eta_b} {name} {side:?} theta {:.1}: slab R {r:.4} T {t:.4}; \
                      simulator R {sr:.4} +- {se_r:.4} T {st:.4} +- {se_t:.4}; \

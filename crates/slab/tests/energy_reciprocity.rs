@@ -9,9 +9,11 @@
 //! sheet (outside grids), the medium alone and the interface (inside grid,
 //! `eta` the medium's index), asked to 1e-10 relative to the largest entry.
 
-use nalgebra::DMatrix;
+mod support;
+
+use support::layer_asymmetry;
 use paperbsdf_core::phase::TwoLobeHg;
-use paperbsdf_slab::{interface::smooth_interface, Discretisation, Face, Grid, Layer, Medium, Side, SlabSpec};
+use paperbsdf_slab::{interface::smooth_interface, Discretisation, Face, Medium, Side, SlabSpec};
 
 fn sheet(albedo: f64, tau: f64, phase: TwoLobeHg, eta: f64) -> SlabSpec {
     SlabSpec {
@@ -76,21 +78,6 @@ fn absorption_only_removes_energy() {
             assert!(r >= 0.0 && t >= 0.0 && r + t < 1.0, "a={albedo} j={j}: {r} {t}");
         }
     }
-}
-
-/// Largest asymmetry of `W_a K_ab` against `(W_b K_ba)^T`, relative to the largest entry.
-fn asymmetry(wa: &[f64], kab: &DMatrix<f64>, wb: &[f64], kba: &DMatrix<f64>) -> f64 {
-    let a = DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(wa)) * kab;
-    let b = DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(wb)) * kba;
-    let diff = (&a - b.transpose()).amax();
-    diff / a.amax().max(b.amax()).max(1e-300)
-}
-
-fn layer_asymmetry(l: &Layer, top: &Grid, bot: &Grid) -> f64 {
-    let (wt, wb) = (top.reciprocity_weights(), bot.reciprocity_weights());
-    asymmetry(&wt, &l.r_top, &wt, &l.r_top)
-        .max(asymmetry(&wb, &l.r_bot, &wb, &l.r_bot))
-        .max(asymmetry(&wb, &l.t_down, &wt, &l.t_up))
 }
 
 #[test]

@@ -29,6 +29,9 @@
 //! which follows from the `Lbar` of the grid instead of core's tables, is
 //! within 0.4% of core's.
 
+mod support;
+
+use support::layer_asymmetry;
 use nalgebra::DMatrix;
 use paperbsdf_core::boundary::{dir_at_mu, directional_albedo_n};
 use paperbsdf_core::{Distribution, FaceScattering, RoughDielectric};
@@ -144,20 +147,6 @@ fn multiple_face_conserves_energy_and_keeps_cores_shares() {
             assert!((c.k_out - k_o).abs() < 1e-12 && (c.k_in - k_i).abs() < 0.01 * k_i.max(0.01));
         }
     }
-}
-
-/// Largest asymmetry of `W_a K_ab` against `(W_b K_ba)^T`, relative to the largest entry.
-fn asymmetry(wa: &[f64], kab: &DMatrix<f64>, wb: &[f64], kba: &DMatrix<f64>) -> f64 {
-    let a = DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(wa)) * kab;
-    let b = DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(wb)) * kba;
-    (&a - b.transpose()).amax() / a.amax().max(b.amax()).max(1e-300)
-}
-
-fn layer_asymmetry(l: &Layer, top: &Grid, bot: &Grid) -> f64 {
-    let (wt, wb) = (top.reciprocity_weights(), bot.reciprocity_weights());
-    asymmetry(&wt, &l.r_top, &wt, &l.r_top)
-        .max(asymmetry(&wb, &l.r_bot, &wb, &l.r_bot))
-        .max(asymmetry(&wb, &l.t_down, &wt, &l.t_up))
 }
 
 #[test]

@@ -25,8 +25,11 @@
 //! (`"single"`, paper-like, 75.3 degrees) and 1.9e-3 (`"multiple"`,
 //! paper-like, 75.3 degrees: slab R 0.8342, simulator 0.8361 +- 0.0008).
 
+mod support;
+
+use support::simulated_totals;
 use paperbsdf_core::{Colour, DVec3, Distribution, FaceScattering, PaperParams};
-use paperbsdf_sim::{simulate_totals, Incidence, SimConfig, Slab};
+use paperbsdf_sim::Slab;
 use paperbsdf_slab::{Discretisation, Side, SlabSpec};
 
 fn sheet(d: f64, sigma_s: f64, sigma_a: f64, fs: FaceScattering) -> PaperParams {
@@ -66,15 +69,7 @@ fn totals_agree_with_the_simulator() {
                 let z = if side == Side::Front { mu } else { -mu };
                 let wi = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, z);
                 let (r, t) = sol.totals_collimated(side, j);
-                let cfg = SimConfig {
-                    samples: walks,
-                    batches: 16,
-                    seed: 17 + j as u64,
-                    ..Default::default()
-                };
-                let s = simulate_totals(&slab, Incidence::Collimated(wi), &cfg).unwrap();
-                let (sr, se_r) = (s.reflectance.mean.0[0], s.reflectance.stderr.0[0]);
-                let (st, se_t) = (s.transmittance.mean.0[0], s.transmittance.stderr.0[0]);
+                let (sr, se_r, st, se_t) = simulated_totals(&slab, wi, walks, 17 + j as u64);
                 println!(
                     "{fs:?} {name} {side:?} theta {:.1}: slab R {r:.4} T {t:.4}; simulator R {sr:.4} +- {se_r:.4} T {st:.4} +- {se_t:.4}",
                     mu.acos().to_degrees()
