@@ -68,7 +68,6 @@
 
 mod support;
 
-use support::{layer_asymmetry, simulated_totals};
 use nalgebra::DMatrix;
 use paperbsdf_core::fresnel::fresnel_dielectric;
 use paperbsdf_core::phase::TwoLobeHg;
@@ -76,6 +75,7 @@ use paperbsdf_core::{Colour, DVec3, Distribution, FaceScattering, PaperParams};
 use paperbsdf_sim::Slab;
 use paperbsdf_slab::{smooth_boundary, Discretisation, Face, Grid, Medium, Side, SlabError, SlabSpec, Solution};
 use std::time::Instant;
+use support::{layer_asymmetry, simulated_totals};
 
 const PAPER_PHASE: TwoLobeHg = TwoLobeHg {
     g_f: 0.8,

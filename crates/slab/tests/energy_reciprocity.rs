@@ -11,9 +11,9 @@
 
 mod support;
 
-use support::layer_asymmetry;
 use paperbsdf_core::phase::TwoLobeHg;
 use paperbsdf_slab::{interface::smooth_interface, Discretisation, Face, Medium, Side, SlabSpec};
+use support::layer_asymmetry;
 
 fn sheet(albedo: f64, tau: f64, phase: TwoLobeHg, eta: f64) -> SlabSpec {
     SlabSpec {

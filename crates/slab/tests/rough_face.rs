@@ -31,12 +31,12 @@
 
 mod support;
 
-use support::layer_asymmetry;
 use nalgebra::DMatrix;
 use paperbsdf_core::boundary::{dir_at_mu, directional_albedo_n};
 use paperbsdf_core::{Distribution, FaceScattering, RoughDielectric};
 use paperbsdf_slab::interface::{face_interface, Projection};
 use paperbsdf_slab::{Grid, Layer};
+use support::layer_asymmetry;
 
 /// `sum_o w_o mu_o K[o][j] / (w_j mu_j)`.
 fn albedo(k: &DMatrix<f64>, to: &Grid, from: &Grid, j: usize) -> f64 {

@@ -27,10 +27,10 @@
 
 mod support;
 
-use support::simulated_totals;
 use paperbsdf_core::{Colour, DVec3, Distribution, FaceScattering, PaperParams};
 use paperbsdf_sim::Slab;
 use paperbsdf_slab::{Discretisation, Side, SlabSpec};
+use support::simulated_totals;
 
 fn sheet(d: f64, sigma_s: f64, sigma_a: f64, fs: FaceScattering) -> PaperParams {
     PaperParams {
