@@ -10,7 +10,7 @@ use paperbsdf_core::{Distribution, FaceScattering};
 use paperbsdf_fit::dataset::load_dataset;
 use paperbsdf_fit::measured::{directional_albedo, in_plane, sample_measured, PointFilter, Sampling};
 use paperbsdf_fit::models::candidates_with_faces;
-use paperbsdf_fit::{fit, fix_params, parse_fix, refine_with_slab, FitModel, FitOptions, Kind, Point, RefineOptions};
+use paperbsdf_fit::{fit, fix_params, parse_fix, refine_with_slab, FitOptions, Kind, Point, RefineOptions};
 
 /// `--refine`: a model that refines the fit from its optimum.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -108,13 +108,7 @@ pub fn run(args: FitArgs) -> Result<()> {
         bail!("--refine-max-iter 0: the refinement needs at least 1 iteration");
     }
     if args.refine.is_some() {
-        match args.model.parse::<paperbsdf_core::models::ModelKind>() {
-            Ok(k) if k.is_slab() && k.is_fittable() => {}
-            _ => bail!(
-                "--refine slab refines a fit of --model paper or reduced-multilayer (the same sheet parameters), not --model {}",
-                args.model
-            ),
-        }
+        paperbsdf_fit::models::refinable(&args.model)?;
     }
     if let Some(out) = &args.out {
         // Before the fit, not after it (issue 16).
@@ -281,9 +275,13 @@ pub fn run(args: FitArgs) -> Result<()> {
         );
     }
     // In-plane and out-of-plane errors, on the fitted and the extrapolation points.
-    let model = match &refined {
-        Some(_) => paperbsdf_fit::models::SlabFit::new(cands[out.variant_index].as_ref())?.build(&out.x)?,
-        None => cands[out.variant_index].build(&out.x)?,
+    let paper_model;
+    let model: &dyn paperbsdf_fit::ComponentModel = match &refined {
+        Some(r) => &r.model,
+        None => {
+            paper_model = cands[out.variant_index].build(&out.x)?;
+            paper_model.as_ref()
+        }
     };
     let (fitted, extra) = paperbsdf_fit::fitter::split_points(&ds.points, fit_theta_i.as_deref());
     fn part<'a>(pts: &[&'a Point], plane: bool) -> Vec<&'a Point> {
@@ -292,10 +290,7 @@ pub fn run(args: FitArgs) -> Result<()> {
     let mut plane_json = serde_json::Map::new();
     for (name, plane) in [("in_plane", true), ("out_of_plane", false)] {
         let (f, e) = (part(&fitted, plane), part(&extra, plane));
-        let (rf, re) = (
-            rms_over(model.as_ref(), &f, ds.channels),
-            rms_over(model.as_ref(), &e, ds.channels),
-        );
+        let (rf, re) = (rms_over(model, &f, ds.channels), rms_over(model, &e, ds.channels));
         if f.is_empty() && e.is_empty() {
             continue;
         }

@@ -280,16 +280,25 @@ pub struct SlabFit<'a> {
     paper: &'a dyn FitModel,
 }
 
+/// Whether a fit of model `name` can be refined with `slab`: a fittable
+/// model with the sheet's parameters (`paper`, `reduced-multilayer`); else
+/// [`FitError::RefineFrom`]. The CLI and the Python package check this before
+/// the fit, [`SlabFit::new`] when it is built.
+pub fn refinable(name: &str) -> Result<ModelKind, FitError> {
+    match name.parse::<ModelKind>() {
+        Ok(k) if k.is_slab() && k.is_fittable() => Ok(k),
+        _ => Err(FitError::RefineFrom {
+            model: name.to_string(),
+        }),
+    }
+}
+
 impl<'a> SlabFit<'a> {
     /// `slab` over the parameters of `paper`; an error if `paper`'s
-    /// parameters are not the sheet's (`lambert-glass`).
+    /// parameters are not the sheet's (`lambert-glass`, [`refinable`]).
     pub fn new(paper: &'a dyn FitModel) -> Result<SlabFit<'a>, FitError> {
-        match paper.model_name().parse::<ModelKind>() {
-            Ok(k) if k.is_slab() && k != ModelKind::Slab => Ok(SlabFit { paper }),
-            _ => Err(FitError::RefineFrom {
-                model: paper.model_name().to_string(),
-            }),
-        }
+        refinable(paper.model_name())?;
+        Ok(SlabFit { paper })
     }
     /// The sheet of values `x`.
     pub fn params(&self, x: &[f64]) -> Result<PaperParams, FitError> {

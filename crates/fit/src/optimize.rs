@@ -90,6 +90,8 @@ pub struct LmResult {
     pub u: Vec<f64>,
     /// Final cost (sum of squared residuals).
     pub cost: f64,
+    /// Cost at the start `u0` (clamped to the box; infinite when the residuals were not finite there).
+    pub start_cost: f64,
     /// Jacobian evaluations used.
     pub iterations: usize,
     /// Residual evaluations used.
@@ -157,12 +159,14 @@ pub fn levenberg_marquardt(
         return LmResult {
             u,
             cost: f64::INFINITY,
+            start_cost: f64::INFINITY,
             iterations: 0,
             evaluations: evals,
             stop: Stop::Invalid,
         };
     }
     let mut cost: f64 = r.iter().map(|x| x * x).sum();
+    let start_cost = cost;
     let mut lambda = 1e-3;
     let mut jac = vec![0.0; m * n];
     let mut rt = vec![0.0; m];
@@ -205,6 +209,7 @@ pub fn levenberg_marquardt(
                 return LmResult {
                     u,
                     cost,
+                    start_cost,
                     iterations: iter,
                     evaluations: evals,
                     stop: Stop::CostTolerance,
@@ -237,6 +242,7 @@ pub fn levenberg_marquardt(
                 return LmResult {
                     u,
                     cost,
+                    start_cost,
                     iterations: iter,
                     evaluations: evals,
                     stop: Stop::Gradient,
@@ -293,6 +299,7 @@ pub fn levenberg_marquardt(
                             return LmResult {
                                 u,
                                 cost,
+                                start_cost,
                                 iterations: iter,
                                 evaluations: evals,
                                 stop: Stop::CostTolerance,
@@ -303,6 +310,7 @@ pub fn levenberg_marquardt(
                                 return LmResult {
                                     u,
                                     cost,
+                                    start_cost,
                                     iterations: iter,
                                     evaluations: evals,
                                     stop: Stop::CostTolerance,
@@ -326,6 +334,7 @@ pub fn levenberg_marquardt(
                 return LmResult {
                     u,
                     cost,
+                    start_cost,
                     iterations: iter,
                     evaluations: evals,
                     stop: Stop::NoDescent,
@@ -336,6 +345,7 @@ pub fn levenberg_marquardt(
     LmResult {
         u,
         cost,
+        start_cost,
         iterations: iter,
         evaluations: evals,
         stop: Stop::MaxIterations,

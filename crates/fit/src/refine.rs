@@ -27,6 +27,7 @@ use crate::objective::{residuals, rms_log_error, sqrt_weights};
 use crate::optimize::{levenberg_marquardt, LmSettings, Stop};
 use crate::report::{identifiability, ReportSettings};
 use crate::Point;
+use paperbsdf_slab::SlabBsdf;
 
 /// `slab`'s own error scale for the uncertainty intervals (RMS log error):
 /// its median error against the exact simulation is 1 to 2%
@@ -73,6 +74,8 @@ pub struct Refinement {
     /// The refined fit: model `slab`, its parameters and errors; its
     /// `evaluations` and `seconds` are the refinement's own.
     pub outcome: FitOutcome,
+    /// The refined model (the solved sheet of `outcome.params`).
+    pub model: SlabBsdf,
     /// The model refined from (`paper` or `reduced-multilayer`).
     pub from_model: String,
     /// That fit's parameter file.
@@ -128,24 +131,20 @@ pub fn refine_with_slab(
     }
     let sw = sqrt_weights(&fitted, channels);
     let m = sw.len();
-    // The start: a solve at the paper optimum (its error is the reference the
-    // refinement can only improve on; a sheet the solver refuses is an error here).
-    let start_model = slab.build(&from.x)?;
-    let (start_rms, _) = rms_log_error(start_model.as_ref(), &fitted, channels).expect("points");
-    drop(start_model);
     let pb = if opts.progress {
         let pb = indicatif::ProgressBar::new_spinner();
         pb.set_style(
             indicatif::ProgressStyle::with_template("{spinner} refine with slab: {pos} solves, {msg} {elapsed}")
                 .expect("template"),
         );
-        pb.set_message(format!("RMS log error {start_rms:.5} at the paper optimum"));
+        pb.set_message("solving at the paper optimum".to_string());
         pb.enable_steady_tick(std::time::Duration::from_millis(200));
         pb
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let best = std::sync::Mutex::new(start_rms * start_rms);
+    // The lowest cost so far, for the progress message (the first is the start's).
+    let best = std::sync::Mutex::new(f64::INFINITY);
     let resid = |u: &[f64], out: &mut [f64]| -> bool {
         let ok = match slab.build(&slab.values(u)) {
             Ok(model) => residuals(model.as_ref(), &fitted, &sw, channels, out),
@@ -157,7 +156,7 @@ pub fn refine_with_slab(
             let mut b = best.lock().expect("no panic while held");
             if cost < *b {
                 *b = cost;
-                pb.set_message(format!("RMS log error {:.5} (start {start_rms:.5})", cost.sqrt()));
+                pb.set_message(format!("RMS log error {:.5}", cost.sqrt()));
             }
         }
         ok
@@ -166,14 +165,18 @@ pub fn refine_with_slab(
     let r = levenberg_marquardt(&resid, &u0, m, &opts.lm);
     pb.finish_and_clear();
     if r.stop == Stop::Invalid {
+        // The solver's own reason if it refused the sheet, else non-finite values.
+        slab.build(&slab.values(&u0))?;
         return Err(FitError::NoValidStart(
             "the slab model gave non-finite values at the paper optimum".to_string(),
         ));
     }
-    let mut evaluations = r.evaluations + 1;
+    // LM's first evaluation was the start: the reference the refinement can only improve on.
+    let start_rms = r.start_cost.sqrt();
+    let mut evaluations = r.evaluations + 1; // and the final model's solve
     let x = slab.values(&r.u);
-    let model = slab.build(&x)?;
-    let (rms, _) = rms_log_error(model.as_ref(), &fitted, channels).expect("points");
+    let model = SlabBsdf::new(&slab.params(&x)?)?;
+    let (rms, _) = rms_log_error(&model, &fitted, channels).expect("points");
     let ident = opts.report.as_ref().and_then(|rs| {
         let rs = ReportSettings { profile: false, ..*rs };
         identifiability(&slab, &r.u, &fitted, &sw, channels, &rs)
@@ -194,7 +197,7 @@ pub fn refine_with_slab(
         &slab,
         from.variant_index,
         x,
-        model.as_ref(),
+        &model,
         points,
         opts.fit_theta_i.as_deref(),
         channels,
@@ -204,6 +207,7 @@ pub fn refine_with_slab(
     );
     Ok(Refinement {
         outcome,
+        model,
         from_model: from.model.clone(),
         from_params: from.params.clone(),
         from_rms_log_error: from.rms_log_error,

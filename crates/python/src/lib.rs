@@ -586,14 +586,7 @@ fn fit(
         }
     }
     if refine.is_some() {
-        match model.parse::<paperbsdf_core::models::ModelKind>() {
-            Ok(k) if k.is_slab() && k.is_fittable() => {}
-            _ => {
-                return Err(value_error(format!(
-                    "refine=\"slab\" refines a fit of model paper or reduced-multilayer (the same sheet parameters), not {model}"
-                )))
-            }
-        }
+        paperbsdf_fit::models::refinable(model).map_err(|e| value_error(e.to_string()))?;
     }
     for (name, v) in &fix {
         if !v.is_finite() {
