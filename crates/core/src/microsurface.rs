@@ -391,38 +391,42 @@ impl Microsurface {
             return 0.0;
         }
         let esc = self.g1(b.z.abs());
-        let o = local(b, outside);
-        let eta_l = if outside { self.eta } else { 1.0 / self.eta };
-        let phase = if (b.z > 0.0) == outside {
-            // Reflection back into the current medium.
-            let h = i + o;
-            let hl = h.length();
-            if hl == 0.0 {
-                return 0.0;
-            }
-            let h = h / hl;
-            let ih = i.dot(h);
-            if h.z <= 0.0 || ih <= 0.0 {
-                return 0.0;
-            }
-            self.visible_density(i, h) * fresnel_dielectric(ih, eta_l) / (4.0 * ih)
+        // Reflection back into the current medium when `b` is on its side.
+        let reflected = (b.z > 0.0) == outside;
+        self.scatter_density(i, outside, local(b, outside), reflected) * esc
+    }
+
+    /// The microfacet phase function of the facets visible from `i` (local
+    /// frame of side `outside`, pointing back along the arriving ray, above
+    /// or below the horizon): the density per steradian of the new
+    /// propagation direction `o`, given in the same local frame, with
+    /// `reflected` saying which event makes it: a reflection (`o` in the
+    /// current medium, above or below the horizon) or a refraction (`o` the
+    /// transmitted direction, beyond the facet). Before any masking of `o`:
+    /// integrated over the sphere, reflection and refraction together, it is
+    /// 1 (tested). [`Microsurface::vertex_density`] is this times the escape
+    /// probability `G1`; a discrete solver of the walk (the `slab` model's
+    /// faces) chains it.
+    pub fn scatter_density(&self, i: DVec3, outside: bool, o: DVec3, reflected: bool) -> f64 {
+        self.scatter_from(i, outside).density(o, reflected)
+    }
+
+    /// [`Microsurface::scatter_density`] for one arriving ray and many new
+    /// directions: the normalisation of the visible normals (Smith's
+    /// `Lambda` of `i`) computed once.
+    pub fn scatter_from(&self, i: DVec3, outside: bool) -> Scatterer {
+        let norm = if i.z == 0.0 { 0.0 } else { self.visible_norm(i) };
+        let inv_norm = if norm > 0.0 && norm.is_finite() {
+            1.0 / norm
         } else {
-            // Refraction into the other medium (relative index eta_l).
-            let Some(h) = upper_unit(-(i + eta_l * o)) else {
-                return 0.0;
-            };
-            let (ih, oh) = (i.dot(h), o.dot(h));
-            if ih <= 0.0 || oh >= 0.0 {
-                return 0.0;
-            }
-            let f = fresnel_dielectric(ih, eta_l);
-            if f >= 1.0 {
-                return 0.0;
-            }
-            let den = ih + eta_l * oh;
-            self.visible_density(i, h) * (1.0 - f) * eta_l * eta_l * (-oh) / (den * den)
+            0.0
         };
-        phase * esc
+        Scatterer {
+            mf: self.mf,
+            i,
+            eta_l: if outside { self.eta } else { 1.0 / self.eta },
+            inv_norm,
+        }
     }
 
     /// Unbiased estimate of the flux density per steradian of `b` with which
@@ -485,6 +489,60 @@ impl Microsurface {
             i = -wl;
         }
         (r, t)
+    }
+}
+
+/// The microfacet phase function of one arriving ray
+/// ([`Microsurface::scatter_from`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Scatterer {
+    mf: Microfacet,
+    /// The arriving ray's reverse direction, in the local frame of its side.
+    i: DVec3,
+    /// Index beyond the microsurface over the index of the ray's side.
+    eta_l: f64,
+    /// `1 / int max(0, i.m) D(m) dm` (0 when nothing is visible).
+    inv_norm: f64,
+}
+
+impl Scatterer {
+    /// [`Microsurface::scatter_density`] of the new direction `o` (same
+    /// local frame), by reflection or by refraction as `reflected` says.
+    #[inline]
+    pub fn density(&self, o: DVec3, reflected: bool) -> f64 {
+        if self.inv_norm == 0.0 {
+            return 0.0;
+        }
+        let (i, eta_l) = (self.i, self.eta_l);
+        let visible = |h: DVec3, ih: f64| ih * self.mf.d(h) * self.inv_norm;
+        if reflected {
+            let h = i + o;
+            let hl = h.length();
+            if hl == 0.0 {
+                return 0.0;
+            }
+            let h = h / hl;
+            let ih = i.dot(h);
+            if h.z <= 0.0 || ih <= 0.0 {
+                return 0.0;
+            }
+            visible(h, ih) * fresnel_dielectric(ih, eta_l) / (4.0 * ih)
+        } else {
+            // Refraction into the other medium (relative index eta_l).
+            let Some(h) = upper_unit(-(i + eta_l * o)) else {
+                return 0.0;
+            };
+            let (ih, oh) = (i.dot(h), o.dot(h));
+            if ih <= 0.0 || oh >= 0.0 {
+                return 0.0;
+            }
+            let f = fresnel_dielectric(ih, eta_l);
+            if f >= 1.0 {
+                return 0.0;
+            }
+            let den = ih + eta_l * oh;
+            visible(h, ih) * (1.0 - f) * eta_l * eta_l * (-oh) / (den * den)
+        }
     }
 }
 

@@ -4,11 +4,14 @@
 //!
 //! **The split into sharp and smooth parts.** What the grid cannot resolve is
 //! kept analytic:
-//! - the lit face's reflection ([`Component::Surface`]): core's face
-//!   ([`PaperBsdf::face_interface_reflection`]: Walter et al. 2007 plus, for
-//!   `face_scattering = "multiple"`, its separable compensation lobe; for a
-//!   coated front the interface's alone, the light its coating/base boundary
-//!   returns being in the solution), or the Fresnel delta of a smooth face
+//! - the lit face's first reflection ([`Component::Surface`]): Walter et al.
+//!   2007 ([`PaperBsdf::face_interface_reflection`] of the same sheet with
+//!   `face_scattering = "single"`; for a coated front the interface's alone,
+//!   the light its coating/base boundary returns being in the solution). For
+//!   `face_scattering = "multiple"` the light the microsurface scatters more
+//!   than once ([`crate::face_walk`]) is in the solution and the table
+//!   (component `direct`), not in this lobe (`paper`'s separable
+//!   compensation lobe is not used). Or the Fresnel delta of a smooth face
 //!   (a smooth coated front's with the coating's interreflections). Its projection on the grid
 //!   ([`crate::interface`]) is what the adding-doubling solution holds for
 //!   that face's first reflection, and it is subtracted from every Fourier
@@ -84,8 +87,9 @@
 //!
 //! **Components.** [`Component::Surface`] (analytic), [`Component::Direct`]
 //! (light that left without scattering in the medium, the lit face's first
-//! reflection excluded: internal reflections and transmission through rough
-//! faces, from the albedo-0 solution; delta lobes are not in `eval`) and
+//! reflection excluded: its microsurface's multiple scattering, internal
+//! reflections and transmission through rough faces, from the albedo-0
+//! solution; delta lobes are not in `eval`) and
 //! [`Component::Multiple`], which here is **every scattering order**, single
 //! scattering included (`slab` does not split orders 1 and 2+).
 
@@ -97,7 +101,7 @@ use paperbsdf_core::fresnel::{cos_transmitted, fresnel_dielectric};
 use paperbsdf_core::geometry::sample_cosine_hemisphere;
 use paperbsdf_core::models::{Component, ComponentModel};
 use paperbsdf_core::paper::Side;
-use paperbsdf_core::{DVec3, PaperBsdf, PaperParams, Rgb};
+use paperbsdf_core::{DVec3, FaceScattering, PaperBsdf, PaperParams, Rgb};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -586,7 +590,13 @@ impl SlabBsdf {
                 });
             }
         }
-        let paper = PaperBsdf::new(p)?;
+        // The analytic surface lobe is Walter's face (the walk's first
+        // order); the light its microsurface scatters more than once is in
+        // the solution (crate::face_walk) and stays in the table.
+        let paper = PaperBsdf::new(&PaperParams {
+            face_scattering: FaceScattering::Single,
+            ..p.clone()
+        })?;
         let specs = [
             SlabSpec::from_params(p, 0)?,
             SlabSpec::from_params(p, 1)?,
@@ -630,7 +640,7 @@ impl SlabBsdf {
         let face_r = |side: usize, m: usize| -> &DMatrix<f64> {
             match (&prepared.coating, side) {
                 (Some(c), 0) if front_smooth_coated => &c.front[m].r_top,
-                _ => &prepared.faces[side].orders[m].r_top,
+                _ => &prepared.faces[side].first_r_top[m],
             }
         };
         fn block(sol: &Solution, side: usize, transmit: bool, m: usize) -> &DMatrix<f64> {
@@ -657,6 +667,7 @@ impl SlabBsdf {
                 return vec![1.0; n];
             }
             let layer = &prepared.faces[s].orders[0];
+            let first = &prepared.faces[s].first_r_top[0];
             let below = match (&prepared.coating, side) {
                 (Some(c), Side::Front) => &c.grid,
                 _ => &prepared.inside,
@@ -664,11 +675,16 @@ impl SlabBsdf {
             (0..n)
                 .map(|j| {
                     let wj = g.w[j] * g.mu[j];
-                    let r_proj: f64 = (0..n).map(|o| g.w[o] * g.mu[o] * layer.r_top[(o, j)]).sum::<f64>() / wj;
+                    let col = |k: &DMatrix<f64>| (0..n).map(|o| g.w[o] * g.mu[o] * k[(o, j)]).sum::<f64>() / wj;
+                    let r_proj = col(first);
+                    // What crosses the face: its transmission and the walk's
+                    // reflection, both in the table.
                     let t_proj: f64 = (0..below.len())
                         .map(|i| below.w[i] * below.mu[i] * layer.t_down[(i, j)])
                         .sum::<f64>()
-                        / wj;
+                        / wj
+                        + col(&layer.r_top)
+                        - r_proj;
                     let r_exact = paper.face_interface_reflectance(side, g.mu[j]);
                     if t_proj > 0.0 {
                         (1.0 - (r_exact - r_proj) / t_proj).max(0.0)

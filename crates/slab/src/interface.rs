@@ -80,33 +80,33 @@
 //! `eval_mode` uses Walter's rational approximation (below 0.35% apart,
 //! `paperbsdf_core::microsurface`); the normalisation follows the former.
 
-//! **Energy compensation** (`face_scattering = "multiple"`): step 2 of
-//! `paperbsdf_core::paper::face`, the model's energy-conserving face. Walter's
-//! face loses `L_o(mu) = 1 - R(mu) - T(mu)` of the light from outside and
-//! `L_i(mu)` of the light from inside; the compensated face adds the
-//! separable, reciprocal lobes
-//! - reflection outside `(1 - k_o) L_o(mu_i) L_o(mu_o) / (pi Lbar_o)`,
-//! - transmission in `k_o L_o(mu_out) L_i(mu_in) / (pi Lbar_i)`,
-//! - reflection inside `(1 - k_i) L_i L_i / (pi Lbar_i)`,
-//! - transmission out `k_i L_i(mu_in) L_o(mu_out) / (pi Lbar_o)`,
+//! **Multiple scattering on the microsurface** (`face_scattering =
+//! "multiple"`): the face the simulator has, the random walk on the Smith
+//! microsurface (Heitz et al. 2016; `paperbsdf_core::microsurface`), whose
+//! first order is Walter's face above and whose orders >= 2
+//! [`crate::face_walk`] solves on the same grids and orders (a Markov chain
+//! in direction, Nystrom on the nodes), scaled symmetrically so that each
+//! node's albedo is exactly what Walter's projected face loses,
+//! `L(mu) = 1 - R(mu) - T(mu)` (so each direction's `R + T` is 1 from both
+//! sides), and added to every order with Fejer's weights `1 - m / M`
+//! (`M` orders): at grazing angles the walk's light is narrower in azimuth
+//! than 32 orders resolve, and the truncated series rang below zero, where
+//! the model's `eval` clamps it (3e-3 of energy added at 85 degrees, tests/slab_bsdf.rs);
+//! Fejer's sum of a non-negative series is non-negative and keeps order 0.
+//! The price is a broadened forward peak at grazing incidence on smooth
+//! faces (luster's Beckmann 0.15 front at 75 degrees, 8% under the simulator at
+//! `theta_o = -80`, docs/accuracy_slab.md).
 //!
-//! (`Lbar = 2 int L mu dmu`), whose albedos are `(1 - k) L` and `k L`, so each
-//! direction's `R + T` is 1 from both sides. The reflection lobe outside is
-//! core's (`paper::face`'s `SeparableLobe`); core gives only the albedos of
-//! the other three, and these are the separable reciprocal lobes with those
-//! albedos. `k_o` is core's: the transmitted share of the energy that the
-//! exact microsurface walk (Heitz et al. 2016) carries by orders >= 2
-//! (`paperbsdf_core::microsurface_tables::lost_energy`); `k_i` follows from
-//! reciprocity, `k_o Lbar_o = eta^2 k_i Lbar_i`, capped at 1 as core does.
-//! The solver takes `L_o`, `L_i` and the `Lbar` from Walter's face **as
-//! projected on the grids** (after normalisation, `1 - ` core's directional
-//! `R + T` at the node; core's model takes them from its tables of the same
-//! integrals), so that the discrete face conserves energy to rounding
-//! wherever Walter's projected albedo does not exceed 1 ([`Compensation::clipped`]).
-//! The compensation is independent of azimuth: it is order 0 only. The
-//! simulator's `"multiple"` faces are the exact walk instead, whose
-//! multiply scattered light is not separable; the tests measure the
-//! difference in the sheet's totals.
+//! This replaces the Paper BSDF's separable compensation lobes
+//! (`paperbsdf_core::paper::face` step 2: reflection
+//! `(1 - k_o) L_o(mu_i) L_o(mu_o) / (pi Lbar_o)` and the like), whose shape
+//! differs from the walk's at grazing angles (3-7% RMS in the sheets'
+//! BSDF against the simulator, docs/accuracy_slab_recheck.md). The walk's
+//! transmitted shares `k_o`, `k_i` ([`Compensation`]) agree with those of
+//! core's Monte Carlo tables of the same walk to 0.5% (tests/rough_face.rs).
+//! A face too smooth for the grid (GGX 0.04 on 32 nodes), whose discretised
+//! walk misses some nodes altogether and cannot be scaled, gets the
+//! separable lobes instead (`compensate`; it loses almost nothing).
 
 use crate::error::SlabError;
 use crate::layer::Layer;
@@ -220,16 +220,20 @@ pub const AZIMUTH_GRADING_LEVELS: i32 = 14;
 /// Smallest number of uniform panels of the azimuth rule on `[0, pi]`.
 pub const MIN_AZIMUTH_PANELS: usize = 16;
 
-/// The energy compensation of a `face_scattering = "multiple"` face as
-/// projected on the grids (module doc): the transmitted shares of the lost
-/// energy and the lost energy itself at every node.
+/// The multiply scattered light of a `face_scattering = "multiple"` face
+/// as projected on the grids (module doc): the transmitted shares of the
+/// energy Walter's face loses and that energy at every node.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Compensation {
+    /// Whether the walk ([`crate::face_walk`]) carries it (`false`: the
+    /// separable lobes of a face too smooth for the grid).
+    pub walk: bool,
     /// `k_o`: transmitted share of the energy lost for light from outside
-    /// (from core's walk tables, `paperbsdf_core::microsurface_tables::lost_energy`).
+    /// (diffuse light, flux-weighted): the walk's, or for separable lobes
+    /// core's walk tables' (`paperbsdf_core::microsurface_tables::lost_energy`).
     pub k_out: f64,
-    /// `k_i`: transmitted share for light from inside, from reciprocity
-    /// `k_o Lbar_o = eta^2 k_i Lbar_i`.
+    /// `k_i`: transmitted share for light from inside (the walk's, or for
+    /// separable lobes from reciprocity `k_o Lbar_o = eta^2 k_i Lbar_i`).
     pub k_in: f64,
     /// `L_o` at the outside nodes: `1 - R - T` of Walter's projected face.
     pub lost_out: Vec<f64>,
@@ -250,8 +254,13 @@ pub struct Compensation {
 pub struct ProjectedFace {
     /// The face's layer for orders `0..orders` (air on top, the medium below).
     pub orders: Vec<Layer>,
-    /// The compensation of a `"multiple"` rough face, `None` otherwise.
+    /// What the multiple scattering of a `"multiple"` rough face carries,
+    /// `None` otherwise.
     pub compensation: Option<Compensation>,
+    /// The face's first reflection from outside per order: `r_top` of
+    /// Walter's face alone (without the walk's orders >= 2; `r_top` itself
+    /// for other faces), what the `slab` model keeps analytic.
+    pub first_r_top: Vec<DMatrix<f64>>,
     /// The normalisation's factors `s` (outside nodes, then inside nodes;
     /// module doc), all 1 without normalisation: how far the raw projection
     /// was from core's albedo.
@@ -355,6 +364,7 @@ pub fn face_interface(
         ));
     }
     let single = |l: Layer| ProjectedFace {
+        first_r_top: vec![l.r_top.clone(); orders],
         orders: vec![l; orders],
         compensation: None,
         scale: vec![1.0; outside.len() + inside.len()],
@@ -377,13 +387,15 @@ pub fn face_interface(
             } else {
                 vec![1.0; outside.len() + inside.len()]
             };
+            let first_r_top = orders_l.iter().map(|l| l.r_top.clone()).collect();
             let compensation = match scattering {
                 FaceScattering::Single => None,
-                FaceScattering::Multiple => Some(compensate(bd, outside, inside, &mut orders_l[0])),
+                FaceScattering::Multiple => Some(add_walk(bd, outside, inside, &mut orders_l, azimuth_points)?),
             };
             Ok(ProjectedFace {
                 orders: orders_l,
                 compensation,
+                first_r_top,
                 scale,
             })
         }
@@ -393,40 +405,32 @@ pub fn face_interface(
 /// The four blocks of Walter's face for every order (module doc's rule).
 fn walter_projection(bd: &RoughDielectric, outside: &Grid, inside: &Grid, orders: usize, n_phi: usize) -> Vec<Layer> {
     let rule = azimuth_rule(orders, n_phi);
-    let phis: Vec<(f64, f64, f64)> = rule.iter().map(|&(phi, wt)| (phi.cos(), phi.sin(), wt)).collect();
-    let cosm: Vec<Vec<f64>> = (0..orders)
-        .map(|m| rule.iter().map(|&(phi, _)| (m as f64 * phi).cos()).collect())
-        .collect();
+    let phis: Vec<(f64, f64)> = rule.iter().map(|&(phi, _)| (phi.cos(), phi.sin())).collect();
+    // cos(m phi_k) times the rule's weight, points x orders: the Fourier sums
+    // of a row are one matrix product (blocked and vectorised by nalgebra).
+    let cos_w = DMatrix::from_fn(rule.len(), orders, |k, m| rule[k].1 * (m as f64 * rule[k].0).cos());
     let block = |from: &Grid, from_top: bool, to: &Grid, to_up: bool| -> Vec<DMatrix<f64>> {
         let (nf, nt) = (from.len(), to.len());
-        let rows: Vec<Vec<f64>> = (0..nt)
+        let rows: Vec<DMatrix<f64>> = (0..nt)
             .into_par_iter()
             .map(|o| {
                 let mu_o = to.mu[o];
                 let s_o = (1.0 - mu_o * mu_o).max(0.0).sqrt();
                 let z_o = if to_up { mu_o } else { -mu_o };
-                let mut row = vec![0.0; orders * nf];
-                let mut vals = vec![0.0; phis.len()];
-                for j in 0..nf {
+                let vals = DMatrix::from_fn(nf, phis.len(), |j, k| {
                     let mu_j = from.mu[j];
                     let s_j = (1.0 - mu_j * mu_j).max(0.0).sqrt();
                     // toward the light: minus the propagation direction (s_j, 0, -+mu_j)
                     let wi = DVec3::new(-s_j, 0.0, if from_top { mu_j } else { -mu_j });
-                    for (k, &(c, s, wt)) in phis.iter().enumerate() {
-                        let wo = DVec3::new(s_o * c, s_o * s, z_o);
-                        vals[k] = wt * bd.eval_mode(wi, wo, TransportMode::Radiance);
-                    }
-                    let scale = from.w[j] * mu_j;
-                    for (m, cm) in cosm.iter().enumerate() {
-                        let acc: f64 = vals.iter().zip(cm).map(|(v, c)| v * c).sum();
-                        row[m * nf + j] = scale * acc;
-                    }
-                }
-                row
+                    let (c, s) = phis[k];
+                    let wo = DVec3::new(s_o * c, s_o * s, z_o);
+                    bd.eval_mode(wi, wo, TransportMode::Radiance)
+                });
+                vals * &cos_w
             })
             .collect();
         (0..orders)
-            .map(|m| DMatrix::from_fn(nt, nf, |o, j| rows[o][m * nf + j]))
+            .map(|m| DMatrix::from_fn(nt, nf, |o, j| from.w[j] * from.mu[j] * rows[o][(j, m)]))
             .collect()
     };
     let r_top = block(outside, true, outside, true);
@@ -536,6 +540,79 @@ fn column_albedo(k: &DMatrix<f64>, to: &Grid, from: &Grid, j: usize) -> f64 {
     (0..to.len()).map(|o| to.w[o] * to.mu[o] * k[(o, j)]).sum::<f64>() / (from.w[j] * from.mu[j])
 }
 
+/// Adds the microsurface walk's orders >= 2 ([`crate::face_walk`]) to
+/// Walter's projected face `l`, scaled to the energy that face loses at each
+/// node (module doc), and returns what was added.
+fn add_walk(
+    bd: &RoughDielectric,
+    outside: &Grid,
+    inside: &Grid,
+    l: &mut [Layer],
+    azimuth_points: usize,
+) -> Result<Compensation, SlabError> {
+    let Interface::Rough(mf) = bd.interface else {
+        return Err(SlabError::Unsupported(
+            "the microsurface walk of a face without microfacets",
+        ));
+    };
+    let mut clipped: f64 = 0.0;
+    let mut lost = |a: f64| {
+        let v = 1.0 - a;
+        clipped = clipped.min(v);
+        v.max(0.0)
+    };
+    let l0 = &l[0];
+    let lost_out: Vec<f64> = (0..outside.len())
+        .map(|j| lost(column_albedo(&l0.r_top, outside, outside, j) + column_albedo(&l0.t_down, inside, outside, j)))
+        .collect();
+    let lost_in: Vec<f64> = (0..inside.len())
+        .map(|j| lost(column_albedo(&l0.r_bot, inside, inside, j) + column_albedo(&l0.t_up, outside, inside, j)))
+        .collect();
+    let lbar = |g: &Grid, lv: &[f64]| 2.0 * (0..g.len()).map(|j| g.w[j] * g.mu[j] * lv[j]).sum::<f64>();
+    let (lbar_o, lbar_i) = (lbar(outside, &lost_out), lbar(inside, &lost_in));
+    let walk = match crate::face_walk::multiple_scattering(
+        mf,
+        bd.eta,
+        outside,
+        inside,
+        l.len(),
+        azimuth_points,
+        [&lost_out, &lost_in],
+    ) {
+        Ok(w) => w,
+        // A face too smooth for the grid (m = 0.04 on 32 nodes): the walk's
+        // discretised light misses some nodes altogether and cannot be
+        // scaled to what they lose. Such a face loses little (its multiple
+        // scattering is tiny), and that light gets core's separable lobes.
+        Err(SlabError::Discretisation { .. }) => return Ok(compensate(bd, outside, inside, &mut l[0])),
+        Err(e) => return Err(e),
+    };
+    // Fejer's weights `1 - m / M` on the walk's orders (module doc): its
+    // light at grazing angles is narrower in azimuth than `M` orders
+    // resolve, and the truncated series rang below zero (where `eval`
+    // clamps it, adding up to 3e-3 of energy at 85 degrees); Fejer's sum of
+    // a non-negative function is non-negative, and order 0 (the energy) is
+    // kept.
+    let big_m = l.len() as f64;
+    for (m, (layer, ms)) in l.iter_mut().zip(&walk.orders).enumerate() {
+        let fejer = 1.0 - m as f64 / big_m;
+        layer.r_top += &ms.r_top * fejer;
+        layer.t_down += &ms.t_down * fejer;
+        layer.r_bot += &ms.r_bot * fejer;
+        layer.t_up += &ms.t_up * fejer;
+    }
+    Ok(Compensation {
+        walk: true,
+        k_out: walk.k.0,
+        k_in: walk.k.1,
+        lost_out,
+        lost_in,
+        lbar_out: lbar_o,
+        lbar_in: lbar_i,
+        clipped,
+    })
+}
+
 /// Adds the separable compensation lobes of step 2 of `paperbsdf_core::paper::face`
 /// to order 0 of Walter's projected face `l` (module doc) and returns them.
 fn compensate(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut Layer) -> Compensation {
@@ -578,6 +655,7 @@ fn compensate(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut Layer
     add(&mut l.r_bot, inside, &lost_in, &lost_in, (1.0 - k_i) * inv(lbar_i));
     add(&mut l.t_up, inside, &lost_in, &lost_out, k_i * inv(lbar_o));
     Compensation {
+        walk: false,
         k_out: k_o,
         k_in: k_i,
         lost_out,

@@ -20,7 +20,8 @@
 //! Beckmann) projected from core's Walter et al. rough dielectric onto the
 //! grids and Fourier orders ([`interface`]: a graded Gauss-Legendre rule in
 //! azimuth, symmetric normalisation to core's directional albedo) with, for
-//! `face_scattering = "multiple"`, core's separable energy compensation;
+//! `face_scattering = "multiple"`, the orders >= 2 of the simulator's
+//! microsurface walk solved on the same grids ([`face_walk`]);
 //! faces of unequal index, i.e. the coated sheet of docs/design.md 4.1
 //! (`eta_f != eta_b`: the rough air/coating front over a coating of zero
 //! thickness and the smooth coating/base boundary, [`slab`]), on a coating
@@ -64,6 +65,7 @@
 
 pub mod bsdf;
 pub mod error;
+pub mod face_walk;
 pub mod interface;
 pub mod layer;
 pub mod phase;

@@ -17,7 +17,9 @@
 //!   largest entry of the block) and within 2e-6 in every total: the
 //!   medium's grid is then the equal-index sheet's, and the coating's extra
 //!   nodes (its cone of total reflection at the boundary, `mu < 1.2e-3`)
-//!   carry almost nothing. From below (`eta_f = eta_b - d`, the base denser)
+//!   carry almost nothing; for `"multiple"` faces, whose walk integrates
+//!   over intermediate directions on those nodes too, within 3e-4 and 4e-5
+//!   (the walk's quadrature error, measured 1.0e-4 and 1.3e-5). From below (`eta_f = eta_b - d`, the base denser)
 //!   the medium's own grid has a panel edge at the boundary's critical
 //!   cosine `sqrt(1 - (eta_f / eta_b)^2) ~ sqrt(2 d / eta_b)` (where its
 //!   reflectance jumps to 1), so the discretisation itself moves by
@@ -272,7 +274,16 @@ fn a_vanishing_coating_is_the_sheet_of_equal_indices() {
             assert!(sol.coating.is_some());
             let (mat, tot) = difference(&plain, &sol);
             println!("{name}: eta_f = eta_b {d:+.0e}: matrices within {mat:.1e} (relative), totals within {tot:.1e}");
-            if d > 0.0 {
+            if d > 0.0 && fs == FaceScattering::Multiple {
+                // The walk's orders >= 2 (crate::face_walk) integrate over the
+                // intermediate directions with the nodes of the grid the face
+                // is projected on, and a coating's grid has more nodes than
+                // the base's (its own cone of total internal reflection), so
+                // the two sheets differ by the walk's quadrature error
+                // (measured 1.0e-4 in the matrices, 1.3e-5 in the totals),
+                // not by the coating.
+                assert!(mat < 3e-4 && tot < 4e-5, "{name}: {mat} {tot}");
+            } else if d > 0.0 {
                 worst_above = (worst_above.0.max(mat), worst_above.1.max(tot));
             } else {
                 let s = d.abs().sqrt();

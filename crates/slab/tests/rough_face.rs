@@ -25,9 +25,10 @@
 //!
 //! With `"multiple"` faces every node's `R + T` is 1 within 1e-12 (the
 //! normalisation's tolerance; measured 9e-13), far inside issue 14's 2e-3,
-//! and `k_o` is core's (`PaperBsdf::face_compensation`) exactly; `k_i`,
-//! which follows from the `Lbar` of the grid instead of core's tables, is
-//! within 0.4% of core's.
+//! and the transmitted shares of the multiply scattered light, which the
+//! discretised walk decides (`paperbsdf_slab::face_walk`), agree with those
+//! of core's Monte Carlo tables of the same walk
+//! (`PaperBsdf::face_compensation`): `k_o` within 0.01, `k_i` within 2%.
 
 mod support;
 
@@ -144,7 +145,15 @@ fn multiple_face_conserves_energy_and_keeps_cores_shares() {
                 c.clipped, c.lbar_out, c.lbar_in, c.k_out, c.k_in
             );
             assert!(worst < 1e-11, "{worst}");
-            assert!((c.k_out - k_o).abs() < 1e-12 && (c.k_in - k_i).abs() < 0.01 * k_i.max(0.01));
+            // The split of the walk's light between R and T comes from the
+            // discretised walk here and from core's Monte Carlo tables there:
+            // two independent computations of one quantity.
+            assert!(
+                (c.k_out - k_o).abs() < 0.01 && (c.k_in - k_i).abs() < 0.02 * k_i.max(0.01),
+                "{dist:?} m = {m}: k_o {} vs {k_o}, k_i {} vs {k_i}",
+                c.k_out,
+                c.k_in
+            );
         }
     }
 }

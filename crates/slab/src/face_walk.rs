@@ -1,0 +1,345 @@
+//! The multiple-scattering rough face (`face_scattering = "multiple"`) as the
+//! simulator has it: the random walk on the Smith microsurface of
+//! `paperbsdf_core::microsurface` (Heitz, Hanika, d'Eon, Dachsbacher,
+//! SIGGRAPH 2016, with the separable masking of the project's Walter face),
+//! solved deterministically on the slab's grids, orders >= 2.
+//!
+//! **The walk is a Markov chain in direction.** In core's walk the height of
+//! each scattering point is drawn afresh, so what happens next depends only
+//! on the ray's side (outside or inside the face) and its propagation
+//! direction `v` in that side's local frame (the medium above the
+//! microsurface, `paperbsdf_core::microsurface`'s `local`): a ray going up
+//! (`v.z > 0`) escapes with probability `G1(v.z)` (exact Smith `G1`) and is
+//! otherwise intercepted; a ray going down is always intercepted. An
+//! intercepted ray meets a facet visible from `-v` (above or below the
+//! horizon) and is reflected or refracted with the phase density
+//! `p(v -> v')` of [`Microsurface::scatter_density`] (per steradian of the new
+//! direction; a refraction puts the ray on the other side, with local
+//! direction minus the transmitted one). Every state is thus one of four
+//! hemispheres: outside going up or down, inside going up or down. The
+//! kernel depends on the azimuth difference only (an isotropic surface), so
+//! Fourier orders decouple as in [`crate::layer`].
+//!
+//! **Discretisation (Nystrom).** The states are the nodes of the slab's own
+//! grids: the outside grid for both outside hemispheres, the inside grid for
+//! both inside hemispheres (`N = 2 (n_out + n_in)` states). Per order `m`,
+//! `P_m[b][a] = integral_0^(2 pi) p(v_a -> v_b(phi)) cos(m phi) dphi` with
+//! `v_a` at azimuth 0, by the graded azimuth rule of [`crate::interface`]
+//! (the kernel's lobes are Walter's). The chain's transfer is
+//! `M = P diag(w_a C_a)` with the grid weight `w_a` and the continuation
+//! probability `C_a` (`1 - G1(mu_a)` going up, 1 going down). Light arriving
+//! at node `a` (a state going down) is first scattered into `P[:, a]`, so
+//! the light scattered twice or more, before its escape, is
+//! `X = (I - M)^-1 M P` and the layer matrix entry (propagation directions,
+//! radiance transport, the convention of [`crate::layer`]) is
+//! `K_m[b][a] = w_a mu_a / mu_b G1(mu_b) X[b][a]` for an exit state `b`
+//! (going up), times `(-1)^m` when `a` and `b` are on different sides: the
+//! inside frame is the global one turned over, which turns azimuths by `pi`.
+//! The same formula with `P` for `X` is order 1, Walter's face with the exact
+//! Smith `G1` (tested against the projection of `RoughDielectric::eval_mode`).
+//!
+//! **Normalisation.** The continuous walk loses nothing, so its orders >= 2
+//! carry exactly what Walter's face loses, `L(mu) = 1 - R(mu) - T(mu)`. The
+//! chain's matrices are made reciprocal (the mean of each block and its
+//! reciprocal image, [`crate::layer`]'s relations) and then scaled
+//! symmetrically (`K[o][j] s_o s_j`, a Sinkhorn iteration as
+//! [`crate::interface`]'s) so that each node's albedo is the `L` that
+//! Walter's projected face leaves: the discrete face conserves energy at
+//! every node, and the chain decides the shape and the split between
+//! reflection and transmission. The factors show how far the raw chain was
+//! ([`WalkFace::scale`]).
+
+use crate::error::SlabError;
+use crate::interface::azimuth_rule;
+use crate::layer::Layer;
+use crate::quad::Grid;
+use nalgebra::DMatrix;
+use paperbsdf_core::microsurface::Microsurface;
+use paperbsdf_core::{DVec3, Microfacet};
+use rayon::prelude::*;
+
+/// Iterations of the symmetric scaling to the lost energy after which it gives up.
+const MAX_SCALING_ITERATIONS: usize = 20_000;
+
+/// One state of the chain: a node of a grid on one side, going up or down.
+#[derive(Clone, Copy, Debug)]
+struct State {
+    outside: bool,
+    up: bool,
+    mu: f64,
+    w: f64,
+}
+
+impl State {
+    /// The local propagation direction at azimuth `phi` given by its cosine and sine.
+    #[inline]
+    fn dir(&self, c: f64, s: f64) -> DVec3 {
+        let st = (1.0 - self.mu * self.mu).max(0.0).sqrt();
+        DVec3::new(st * c, st * s, if self.up { self.mu } else { -self.mu })
+    }
+}
+
+/// The orders >= 2 of the walk as layers, and what the normalisation did.
+#[derive(Clone, Debug)]
+pub struct WalkFace {
+    /// The multiply scattered light per Fourier order (the four blocks of a
+    /// face: outside grid on top, inside grid below), normalised.
+    pub orders: Vec<Layer>,
+    /// The chain's own order-0 albedo per node before the normalisation
+    /// (outside nodes, then inside nodes): what the discretised walk returns
+    /// of the light Walter's face loses.
+    pub raw_albedo: Vec<f64>,
+    /// The symmetric scaling factors (outside nodes, then inside nodes).
+    pub scale: Vec<f64>,
+    /// Flux-weighted share of the multiply scattered light that is
+    /// transmitted, for diffuse light from outside (`k_o` of core's
+    /// compensation) and from inside (`k_i`).
+    pub k: (f64, f64),
+}
+
+/// The states in order: outside up, outside down, inside up, inside down.
+fn states(outside: &Grid, inside: &Grid) -> Vec<State> {
+    let mut v = Vec::with_capacity(2 * (outside.len() + inside.len()));
+    for (g, out) in [(outside, true), (inside, false)] {
+        for up in [true, false] {
+            for (&mu, &w) in g.mu.iter().zip(&g.w) {
+                v.push(State {
+                    outside: out,
+                    up,
+                    mu,
+                    w,
+                });
+            }
+        }
+    }
+    v
+}
+
+/// `P_m` for every order (module doc), as `orders` matrices `N x N`.
+fn phase_matrices(s: &Microsurface, st: &[State], orders: usize, q: usize) -> Vec<DMatrix<f64>> {
+    let rule = azimuth_rule(orders, q);
+    let n_phi = rule.len();
+    // cos(m phi_k) weighted by the rule, n_phi x orders: a column's Fourier
+    // coefficients are one matrix product (blocked and vectorised by nalgebra).
+    let cos_w = DMatrix::from_fn(n_phi, orders, |k, m| rule[k].1 * (m as f64 * rule[k].0).cos());
+    let phis: Vec<(f64, f64)> = rule.iter().map(|&(phi, _)| (phi.cos(), phi.sin())).collect();
+    let n = st.len();
+    let cols: Vec<DMatrix<f64>> = st
+        .par_iter()
+        .map(|a| {
+            let sc = s.scatter_from(-a.dir(1.0, 0.0), a.outside);
+            let vals = DMatrix::from_fn(n, n_phi, |b_idx, k| {
+                let b = &st[b_idx];
+                let (c, sn) = phis[k];
+                let vb = b.dir(c, sn);
+                if a.outside == b.outside {
+                    sc.density(vb, true)
+                } else {
+                    sc.density(-vb, false)
+                }
+            });
+            vals * &cos_w
+        })
+        .collect();
+    (0..orders)
+        .map(|m| DMatrix::from_fn(n, n, |b, a| cols[a][(b, m)]))
+        .collect()
+}
+
+/// The layer of order `m` from `X` (rows: exit states, columns: arrival
+/// states; module doc's `K_m[b][a]`; `X = P` gives order 1).
+fn to_layer(s: &Microsurface, st: &[State], x: &DMatrix<f64>, m: usize, no: usize, ni: usize) -> Layer {
+    // Index ranges of the four hemispheres.
+    let (o_up, o_dn, i_up, i_dn) = (0, no, 2 * no, 2 * no + ni);
+    let sign = if m % 2 == 1 { -1.0 } else { 1.0 };
+    let block = |rows: usize, nr: usize, cols: usize, nc: usize, sg: f64| {
+        DMatrix::from_fn(nr, nc, |b, a| {
+            let (sb, sa) = (&st[rows + b], &st[cols + a]);
+            sg * sa.w * sa.mu / sb.mu * s.g1(sb.mu) * x[(rows + b, cols + a)]
+        })
+    };
+    Layer {
+        r_top: block(o_up, no, o_dn, no, 1.0),
+        t_down: block(i_up, ni, o_dn, no, sign),
+        r_bot: block(i_up, ni, i_dn, ni, 1.0),
+        t_up: block(o_up, no, i_dn, ni, sign),
+    }
+}
+
+/// Order 1 of the walk on the grids (Walter's face with the exact Smith
+/// `G1`, unnormalised), for checking the chain's conventions against
+/// [`crate::interface`]'s projection of `RoughDielectric::eval_mode`.
+pub fn single_scattering(
+    mf: Microfacet,
+    eta: f64,
+    outside: &Grid,
+    inside: &Grid,
+    orders: usize,
+    q: usize,
+) -> Vec<Layer> {
+    let s = Microsurface::new(mf, eta);
+    let st = states(outside, inside);
+    let p = phase_matrices(&s, &st, orders, q);
+    p.iter()
+        .enumerate()
+        .map(|(m, pm)| to_layer(&s, &st, pm, m, outside.len(), inside.len()))
+        .collect()
+}
+
+/// The walk's orders >= 2 for the face of distribution `mf` and relative
+/// index `eta` between the grids `outside` (air) and `inside`, scaled so that
+/// the albedo of every node is `lost[0][j]` (outside nodes) or
+/// `lost[1][j]` (inside nodes): the energy Walter's projected face loses
+/// (module doc). `orders` Fourier orders, `q` points per azimuth panel.
+pub fn multiple_scattering(
+    mf: Microfacet,
+    eta: f64,
+    outside: &Grid,
+    inside: &Grid,
+    orders: usize,
+    q: usize,
+    lost: [&[f64]; 2],
+) -> Result<WalkFace, SlabError> {
+    let [lost_out, lost_in] = lost;
+    let s = Microsurface::new(mf, eta);
+    let st = states(outside, inside);
+    let n = st.len();
+    let (no, ni) = (outside.len(), inside.len());
+    let p = phase_matrices(&s, &st, orders, q);
+    let cont: Vec<f64> = st
+        .iter()
+        .map(|a| a.w * if a.up { 1.0 - s.g1(a.mu) } else { 1.0 })
+        .collect();
+    let layers: Vec<Layer> = p
+        .par_iter()
+        .enumerate()
+        .map(|(m, pm)| {
+            let mut mm = pm.clone();
+            for (a, c) in cont.iter().enumerate() {
+                mm.column_mut(a).scale_mut(*c);
+            }
+            let rhs = &mm * pm;
+            let a = DMatrix::identity(n, n) - &mm;
+            let x = a.lu().solve(&rhs).ok_or(SlabError::Singular {
+                step: "the microsurface walk's chain",
+            })?;
+            Ok(symmetrised(to_layer(&s, &st, &x, m, no, ni), outside, inside))
+        })
+        .collect::<Result<_, SlabError>>()?;
+    let raw_albedo = albedos(&layers[0], outside, inside);
+    let scale = symmetric_scaling(&layers[0], outside, inside, lost_out, lost_in)?;
+    let (s_out, s_in) = scale.split_at(no);
+    let mut layers = layers;
+    for l in layers.iter_mut() {
+        scale_rows_cols(&mut l.r_top, s_out, s_out);
+        scale_rows_cols(&mut l.t_down, s_in, s_out);
+        scale_rows_cols(&mut l.r_bot, s_in, s_in);
+        scale_rows_cols(&mut l.t_up, s_out, s_in);
+    }
+    let share = |t: &DMatrix<f64>, from: &Grid, to: &Grid, lost: &[f64]| -> f64 {
+        let total: f64 = (0..from.len()).map(|j| from.w[j] * from.mu[j] * lost[j]).sum();
+        if total <= 0.0 {
+            return 0.0;
+        }
+        let tr: f64 = (0..from.len())
+            .map(|j| (0..to.len()).map(|o| to.w[o] * to.mu[o] * t[(o, j)]).sum::<f64>())
+            .sum();
+        tr / total
+    };
+    let k = (
+        share(&layers[0].t_down, outside, inside, lost_out),
+        share(&layers[0].t_up, inside, outside, lost_in),
+    );
+    Ok(WalkFace {
+        orders: layers,
+        raw_albedo,
+        scale,
+        k,
+    })
+}
+
+/// The layer made exactly reciprocal: each block averaged with its image
+/// under the relations of [`crate::layer`] (`W R` symmetric,
+/// `W_bot T_down = (W_top T_up)^T`, `W = diag(w mu / eta^2)`).
+fn symmetrised(l: Layer, top: &Grid, bot: &Grid) -> Layer {
+    let (wt, wb) = (top.reciprocity_weights(), bot.reciprocity_weights());
+    let refl = |r: &DMatrix<f64>, w: &[f64]| {
+        DMatrix::from_fn(r.nrows(), r.ncols(), |o, j| 0.5 * (r[(o, j)] + w[j] * r[(j, o)] / w[o]))
+    };
+    // Z = (W_bot T_down + (W_top T_up)^T) / 2.
+    let z = DMatrix::from_fn(bot.len(), top.len(), |o, j| {
+        0.5 * (wb[o] * l.t_down[(o, j)] + wt[j] * l.t_up[(j, o)])
+    });
+    Layer {
+        r_top: refl(&l.r_top, &wt),
+        t_down: DMatrix::from_fn(bot.len(), top.len(), |o, j| z[(o, j)] / wb[o]),
+        r_bot: refl(&l.r_bot, &wb),
+        t_up: DMatrix::from_fn(top.len(), bot.len(), |o, j| z[(j, o)] / wt[o]),
+    }
+}
+
+/// Order-0 albedo `R + T` of every node (outside, then inside).
+fn albedos(l: &Layer, top: &Grid, bot: &Grid) -> Vec<f64> {
+    let col =
+        |k: &DMatrix<f64>, to: &Grid, j: usize| (0..to.len()).map(|o| to.w[o] * to.mu[o] * k[(o, j)]).sum::<f64>();
+    let out = (0..top.len()).map(|j| (col(&l.r_top, top, j) + col(&l.t_down, bot, j)) / (top.w[j] * top.mu[j]));
+    let ins = (0..bot.len()).map(|j| (col(&l.r_bot, bot, j) + col(&l.t_up, top, j)) / (bot.w[j] * bot.mu[j]));
+    out.chain(ins).collect()
+}
+
+/// Factors `s` (outside nodes, then inside nodes) such that `K[o][j] s_o s_j`
+/// has the albedos `target` (a symmetric Sinkhorn iteration; a node whose
+/// target is 0 gets factor 0).
+fn symmetric_scaling(l: &Layer, top: &Grid, bot: &Grid, t_out: &[f64], t_in: &[f64]) -> Result<Vec<f64>, SlabError> {
+    let (no, ni) = (top.len(), bot.len());
+    let target: Vec<f64> = t_out.iter().chain(t_in).copied().collect();
+    let mut s: Vec<f64> = target.iter().map(|&t| if t > 0.0 { 1.0 } else { 0.0 }).collect();
+    // Column sums with the current factors: a_j = s_j sum_o w_o mu_o s_o K[o][j] / (w_j mu_j).
+    let col = |k: &DMatrix<f64>, to: &Grid, s_to: &[f64], j: usize| -> f64 {
+        (0..to.len())
+            .map(|o| to.w[o] * to.mu[o] * s_to[o] * k[(o, j)])
+            .sum::<f64>()
+    };
+    for _ in 0..MAX_SCALING_ITERATIONS {
+        let (s_out, s_in) = s.split_at(no);
+        let a: Vec<f64> = (0..no)
+            .map(|j| s_out[j] * (col(&l.r_top, top, s_out, j) + col(&l.t_down, bot, s_in, j)) / (top.w[j] * top.mu[j]))
+            .chain((0..ni).map(|j| {
+                s_in[j] * (col(&l.r_bot, bot, s_in, j) + col(&l.t_up, top, s_out, j)) / (bot.w[j] * bot.mu[j])
+            }))
+            .collect();
+        let mut worst: f64 = 0.0;
+        for ((sj, aj), tj) in s.iter_mut().zip(&a).zip(&target) {
+            if *tj <= 0.0 {
+                continue;
+            }
+            if !(*aj > 0.0 && aj.is_finite()) {
+                return Err(unresolved());
+            }
+            worst = worst.max((aj / tj - 1.0).abs());
+            *sj *= (tj / aj).sqrt();
+        }
+        if worst < 1e-12 {
+            return Ok(s);
+        }
+    }
+    Err(unresolved())
+}
+
+/// `K[o][j] *= rows[o] cols[j]`.
+fn scale_rows_cols(k: &mut DMatrix<f64>, rows: &[f64], cols: &[f64]) {
+    for j in 0..k.ncols() {
+        for o in 0..k.nrows() {
+            k[(o, j)] *= rows[o] * cols[j];
+        }
+    }
+}
+
+/// The error of a walk the grid does not resolve.
+fn unresolved() -> SlabError {
+    SlabError::Discretisation {
+        name: "nodes",
+        value: f64::NAN,
+        range: "enough nodes to resolve the rough face's multiple scattering (its scaling to the lost energy did not converge)",
+    }
+}

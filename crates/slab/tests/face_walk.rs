@@ -1,0 +1,142 @@
+//! The microsurface walk solved on the grids (`paperbsdf_slab::face_walk`):
+//! (a) its order 1 is Walter's face as `interface` projects it from
+//! `RoughDielectric::eval_mode` (a separate code path: core's closed form
+//! against the chain's phase function and escape probability), in every
+//! order and block, which checks the chain's frames and the `(-1)^m` of its
+//! side changes; (b) before its scaling the discretised walk's orders >= 2
+//! return what Walter's projected face loses at every node (energy
+//! conservation of the walk, which the discretisation does not impose),
+//! within the quadrature error of the lobes on 32 nodes (measured below);
+//! (c) the scaled face is reciprocal in every order.
+//!
+//! The split of that light between reflection and transmission is checked
+//! against core's Monte Carlo tables of the same walk in tests/rough_face.rs,
+//! and sheets with these faces against the simulator in tests/simulator.rs
+//! and docs/accuracy_slab.md.
+
+mod support;
+
+use paperbsdf_core::{Distribution, FaceScattering, Microfacet, RoughDielectric};
+use paperbsdf_slab::face_walk::{multiple_scattering, single_scattering};
+use paperbsdf_slab::interface::{face_interface, Projection};
+use paperbsdf_slab::Grid;
+use support::layer_asymmetry;
+
+fn grids(eta: f64, nodes: usize) -> (Grid, Grid) {
+    let out = Grid::outside(nodes);
+    let ins = Grid::inside(&out, eta, nodes / 2);
+    (out, ins)
+}
+
+/// GGX: identical up to rounding (both use the exact Smith `G1`); Beckmann:
+/// `eval_mode` uses Walter's rational `G1`, within 0.35% of the exact one
+/// per direction (core's microsurface module), so within 0.7% per entry.
+#[test]
+fn order_one_is_walters_projection() {
+    let (out, ins) = grids(1.5, 16);
+    for (dist, m, tol) in [
+        (Distribution::Ggx, 0.3, 1e-6),
+        (Distribution::Ggx, 0.8, 1e-6),
+        (Distribution::Beckmann, 0.4, 7e-3),
+    ] {
+        let bd = RoughDielectric::new(dist, 1.5, m).unwrap();
+        let proj = Projection {
+            orders: 6,
+            azimuth_points: 8,
+            normalise: false,
+        };
+        let walter = face_interface(&bd, FaceScattering::Single, &out, &ins, &proj).unwrap();
+        let chain = single_scattering(Microfacet::new(dist, m), 1.5, &out, &ins, 6, 8);
+        let mut worst: f64 = 0.0;
+        for (w, c) in walter.orders.iter().zip(&chain) {
+            for (a, b) in [
+                (&w.r_top, &c.r_top),
+                (&w.t_down, &c.t_down),
+                (&w.r_bot, &c.r_bot),
+                (&w.t_up, &c.t_up),
+            ] {
+                worst = worst.max((a - b).abs().max() / a.abs().max());
+            }
+        }
+        println!("{dist:?} m = {m}: order 1 of the chain vs Walter's projection: {worst:.1e} (relative to each block's largest entry)");
+        assert!(worst < tol, "{dist:?} m = {m}: {worst}");
+    }
+}
+
+/// The walk's raw orders >= 2 against `1 - (R + T)` of Walter's projected
+/// face, per node, from both sides, 32 nodes, at the roughness of paper
+/// faces and beyond.
+#[test]
+fn discretised_walk_returns_what_walter_loses() {
+    let (out, ins) = grids(1.5, 32);
+    for (dist, m) in [
+        (Distribution::Ggx, 0.3),
+        (Distribution::Ggx, 0.6),
+        (Distribution::Beckmann, 0.45),
+    ] {
+        let bd = RoughDielectric::new(dist, 1.5, m).unwrap();
+        let proj = Projection {
+            orders: 1,
+            azimuth_points: 8,
+            normalise: true,
+        };
+        let walter = face_interface(&bd, FaceScattering::Single, &out, &ins, &proj).unwrap();
+        let l = &walter.orders[0];
+        let albedo = |k: &nalgebra::DMatrix<f64>, to: &Grid, from: &Grid, j: usize| {
+            (0..to.len()).map(|o| to.w[o] * to.mu[o] * k[(o, j)]).sum::<f64>() / (from.w[j] * from.mu[j])
+        };
+        let lost_out: Vec<f64> = (0..out.len())
+            .map(|j| 1.0 - albedo(&l.r_top, &out, &out, j) - albedo(&l.t_down, &ins, &out, j))
+            .collect();
+        let lost_in: Vec<f64> = (0..ins.len())
+            .map(|j| 1.0 - albedo(&l.r_bot, &ins, &ins, j) - albedo(&l.t_up, &out, &ins, j))
+            .collect();
+        let walk = multiple_scattering(Microfacet::new(dist, m), 1.5, &out, &ins, 1, 8, [&lost_out, &lost_in]).unwrap();
+        let lost: Vec<f64> = lost_out.iter().chain(&lost_in).copied().collect();
+        // Absolute error per node, and relative to the node's lost energy where it is above 1e-3.
+        let (mut abs, mut rel): (f64, f64) = (0.0, 0.0);
+        for (a, t) in walk.raw_albedo.iter().zip(&lost) {
+            abs = abs.max((a - t).abs());
+            if *t > 1e-3 {
+                rel = rel.max((a / t - 1.0).abs());
+            }
+        }
+        let lbar: f64 = out
+            .w
+            .iter()
+            .zip(&out.mu)
+            .zip(&lost_out)
+            .map(|((w, mu), x)| 2.0 * w * mu * x)
+            .sum();
+        println!(
+            "{dist:?} m = {m}: walk's raw albedo vs Walter's loss: {abs:.1e} absolute, {rel:.1e} relative (Lbar_o {lbar:.4}; k_o {:.4}, k_i {:.4})",
+            walk.k.0, walk.k.1
+        );
+        // Not closer: every scattering of the walk is a quadrature on the
+        // nodes of lobes that end in kinks (as Walter's raw projection, up to
+        // 3e-2 in albedo, tests/rough_face.rs), and the chain compounds them;
+        // measured 1.2e-2 / 7.6% (GGX 0.3), 3.7e-2 / 11% (GGX 0.6, where the
+        // walk returns up to a third of the light at grazing inside nodes).
+        // The scaling to Walter's loss removes it from the energy; a wrong
+        // factor or frame in the chain shows as errors of order 1.
+        assert!(abs < 0.05 && rel < 0.15, "{dist:?} m = {m}: {abs} {rel}");
+    }
+}
+
+#[test]
+fn walk_face_is_reciprocal_in_every_order() {
+    for eta in [1.33, 1.6] {
+        let (out, ins) = grids(eta, 20);
+        let bd = RoughDielectric::new(Distribution::Beckmann, eta, 0.5).unwrap();
+        let proj = Projection {
+            orders: 8,
+            azimuth_points: 8,
+            normalise: true,
+        };
+        let face = face_interface(&bd, FaceScattering::Multiple, &out, &ins, &proj).unwrap();
+        for l in &face.orders {
+            let a = layer_asymmetry(l, &out, &ins);
+            assert!(a < 1e-12, "eta {eta}: {a}");
+        }
+    }
+}
