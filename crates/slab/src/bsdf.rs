@@ -119,7 +119,11 @@ pub struct SlabOptions {
     pub nodes: usize,
     /// Nodes in the cone of total internal reflection ([`Discretisation::tir_nodes`]).
     pub tir_nodes: usize,
-    /// Fourier orders in azimuth, 1 to [`MAX_ORDERS`].
+    /// Fourier orders in azimuth, 1 to [`MAX_ORDERS`]; default 48: the
+    /// microsurface walk's forward light at grazing incidence on a smooth
+    /// face is narrow in azimuth (luster's Beckmann 0.15 front at 75
+    /// degrees: RMS log error against the simulator 0.022 with 32 orders,
+    /// 0.016 with 48, 0.012 with 64; build 0.48 / 0.63 / 0.9 s).
     pub orders: usize,
     /// Bins in `|phi|` of the sampling density, 1 to 1024.
     pub phi_bins: usize,
@@ -132,7 +136,7 @@ impl Default for SlabOptions {
         SlabOptions {
             nodes: 32,
             tir_nodes: 16,
-            orders: 32,
+            orders: 48,
             phi_bins: 32,
             mu_bins: 32,
         }

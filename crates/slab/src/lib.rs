@@ -51,8 +51,9 @@
 //!
 //! **What is missing for issue 13.** Lobes narrower than the grid
 //! (roughness below about 0.1, e.g. the glossy preset's m_f = 0.04: the
-//! face's own reflection is analytic, but the light it lets in and out is
-//! projected on 32 nodes, which do not resolve it); further analytic parts
+//! face's own reflection is analytic, but the light it lets in and out, and
+//! its microsurface's multiple scattering, are projected on 32 nodes, which
+//! do not resolve them); further analytic parts
 //! (unscattered transmission through rough faces, exact single scattering
 //! as its own term: the tables hold every scattering order, so `slab` has
 //! no separate `single` component); the R/T split of the projected faces

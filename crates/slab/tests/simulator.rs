@@ -16,10 +16,10 @@
 //! these totals by at most 5.6e-4, tests/rough_convergence.rs), the split of
 //! each face's R and T (within 1e-3 from outside and 5e-3 from inside of
 //! core's quadrature, tests/rough_face.rs) and, for `"multiple"`, the
-//! difference of the faces themselves: the solver's face is core's model of
-//! the energy-conserving face (Walter's lobe plus separable compensation
-//! lobes), the simulator's the exact random walk on the microsurface (Heitz
-//! et al. 2016). Measured once with 40 times the walks of this test
+//! discretisation of the faces' microsurface walk (the simulator's walk,
+//! Heitz et al. 2016, solved on the grids: `paperbsdf_slab::face_walk`;
+//! until 2026-12-04 the solver's face was core's separable compensation
+//! instead, and the figures below were measured with it). Measured once with 40 times the walks of this test
 //! (800k thin, 160k paper-like; 0, 43.5 and 75.3 degrees): every total
 //! within 2.2 sigma (sigma 4e-4 to 1.2e-3), largest differences 1.2e-3
 //! (`"single"`, paper-like, 75.3 degrees) and 1.9e-3 (`"multiple"`,
