@@ -207,17 +207,24 @@ impl SmoothSheet {
 struct Tables {
     /// `c_m[o][j]` at `(o n + j) M + m`.
     c: [[Vec<Rgb>; 2]; 2],
-    /// Per `(o n + j)`: the orders `0..len` whose coefficients exceed
-    /// [`ORDER_CUTOFF`] of the pair's largest (the same for a pair and its
-    /// reciprocal, so truncation keeps reciprocity exact).
+    /// Per `(o n + j)`: the orders `0..len` kept, the fewest whose dropped
+    /// tail sums to at most [`ORDER_CUTOFF`] of the pair's largest
+    /// coefficient (the same for a pair and its reciprocal, so truncation
+    /// keeps reciprocity exact).
     len: [[Vec<u16>; 2]; 2],
 }
 
-/// Relative size below which a pair's higher Fourier orders are dropped
-/// (their sum changes `f` by at most `orders * ORDER_CUTOFF` of the pair's
-/// largest coefficient), and absolute size below which a coefficient is 0
-/// (no subnormal arithmetic in `eval`).
-const ORDER_CUTOFF: f64 = 1e-9;
+/// A pair's highest Fourier orders are dropped while the sum of their
+/// magnitudes stays below this fraction of the pair's largest coefficient,
+/// so truncation changes `f` by at most that much (`TINY`: the absolute
+/// size below which a coefficient is 0, no subnormal arithmetic in `eval`).
+/// Measured on the presets at 60000 direction pairs: `eval` and `pdf`
+/// within 1e-5 (relative, values above 1e-3) of the untruncated tables.
+/// Until 2026-12-04 each dropped coefficient was below 1e-9 of the largest;
+/// the microsurface walk's Fejer-weighted orders (`crate::interface`) are
+/// above that to the last order, so every pair kept all 48 and a matte
+/// sample took 361 instead of 279 ns (criterion).
+const ORDER_CUTOFF: f64 = 1e-5;
 const TINY: f64 = 1e-200;
 
 impl Tables {
@@ -239,11 +246,19 @@ impl Tables {
                             .iter()
                             .map(|v| v.0.iter().fold(0.0f64, |a, x| a.max(x.abs())))
                             .fold(0.0, f64::max);
-                        let last = coef
-                            .iter()
-                            .rposition(|v| v.0.iter().any(|x| x.abs() > ORDER_CUTOFF * big))
-                            .map_or(0, |m| m + 1);
-                        last.max(1) as u16
+                        // The fewest orders whose dropped tail sums to at
+                        // most ORDER_CUTOFF of the largest coefficient.
+                        let mut tail = 0.0;
+                        let mut last = coef.len();
+                        while last > 1 {
+                            let v = &coef[last - 1].0;
+                            tail += v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+                            if tail > ORDER_CUTOFF * big {
+                                break;
+                            }
+                            last -= 1;
+                        }
+                        last as u16
                     })
                     .collect();
             }
