@@ -54,7 +54,7 @@
 //! loses little, and `crate::interface` gives it separable lobes.
 
 use crate::error::SlabError;
-use crate::interface::azimuth_rule;
+use crate::interface::{azimuth_rule, scale_rows_cols};
 use crate::layer::Layer;
 use crate::quad::Grid;
 use nalgebra::DMatrix;
@@ -350,15 +350,6 @@ fn symmetric_scaling(l: &Layer, top: &Grid, bot: &Grid, t_out: &[f64], t_in: &[f
         }
     }
     Err(unresolved())
-}
-
-/// `K[o][j] *= rows[o] cols[j]`.
-fn scale_rows_cols(k: &mut DMatrix<f64>, rows: &[f64], cols: &[f64]) {
-    for j in 0..k.ncols() {
-        for o in 0..k.nrows() {
-            k[(o, j)] *= rows[o] * cols[j];
-        }
-    }
 }
 
 /// The error of a walk the grid does not resolve.

@@ -536,7 +536,7 @@ fn normalise_face(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut [
 }
 
 /// `K[o][j] *= rows[o] cols[j]`.
-fn scale_rows_cols(k: &mut DMatrix<f64>, rows: &[f64], cols: &[f64]) {
+pub(crate) fn scale_rows_cols(k: &mut DMatrix<f64>, rows: &[f64], cols: &[f64]) {
     for j in 0..k.ncols() {
         for o in 0..k.nrows() {
             k[(o, j)] *= rows[o] * cols[j];
