@@ -28,112 +28,18 @@ use paperbsdf_core::bsdf::sampled_albedo;
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::models::ComponentModel;
 use paperbsdf_core::paper::{Component, PaperBsdf};
-use paperbsdf_core::{Bsdf, Colour, Distribution, PaperParams, Rgb};
+use paperbsdf_core::{Bsdf, PaperParams, Rgb};
 use paperbsdf_sim::{simulate_bsdf, Estimate, SimConfig, Slab};
 use paperbsdf_slab::SlabBsdf;
 use plotters::prelude::*;
 use std::fmt::Write as _;
 
+#[path = "support/cases.rs"]
+mod cases;
+use cases::cases;
+
 const THETA_I: [f64; 4] = [0.0, 30.0, 60.0, 75.0];
 const E_LOG: f64 = 1e-3;
-
-fn paper(name: &str, d: f64, sigma_a: f64, sigma_s: f64, m_f: f64, m_b: f64, dist_f: Distribution) -> PaperParams {
-    PaperParams {
-        name: Some(name.into()),
-        d,
-        sigma_a: Colour::Scalar(sigma_a),
-        sigma_s: Colour::Scalar(sigma_s),
-        g_f: 0.8,
-        g_b: -0.3,
-        w_b: 0.2,
-        eta_f: 1.5,
-        eta_b: 1.5,
-        m_f,
-        m_b,
-        dist_f,
-        dist_b: Distribution::Ggx,
-        face_scattering: Default::default(),
-    }
-}
-
-fn cases() -> Vec<(String, PaperParams)> {
-    let dev = |f: &str| -> PaperParams {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/reference/").to_string() + f;
-        serde_json::from_str(&std::fs::read_to_string(&path).expect("reference parameters")).expect("valid JSON")
-    };
-    let mut v: Vec<(String, PaperParams)> = paperbsdf_core::presets::PRESET_NAMES
-        .iter()
-        .map(|n| {
-            (
-                format!("preset-{n}"),
-                paperbsdf_core::presets::preset(n).expect("preset"),
-            )
-        })
-        .collect();
-    v.push(("devA".into(), dev("devA.json")));
-    v.push(("devB".into(), dev("devB.json")));
-    v.push((
-        "thin-tissue".into(),
-        paper(
-            "thin tissue: d 0.03, tau 1.2, m 0.3",
-            0.03,
-            0.3,
-            40.0,
-            0.3,
-            0.3,
-            Distribution::Ggx,
-        ),
-    ));
-    v.push((
-        "weak-scatter".into(),
-        paper(
-            "weakly scattering: d 0.1, tau 3, m 0.3",
-            0.1,
-            0.5,
-            30.0,
-            0.3,
-            0.3,
-            Distribution::Ggx,
-        ),
-    ));
-    v.push((
-        "thick-board".into(),
-        paper(
-            "thick board: d 0.3, tau 60, m 0.3",
-            0.3,
-            0.5,
-            200.0,
-            0.3,
-            0.3,
-            Distribution::Ggx,
-        ),
-    ));
-    v.push((
-        "smooth-front".into(),
-        paper(
-            "smooth front: m_f 0.05 beckmann, d 0.1, tau 15",
-            0.1,
-            0.5,
-            150.0,
-            0.05,
-            0.3,
-            Distribution::Beckmann,
-        ),
-    ));
-    v.push((
-        "very-rough".into(),
-        paper(
-            "very rough: m 0.9, d 0.1, tau 15",
-            0.1,
-            0.5,
-            150.0,
-            0.9,
-            0.9,
-            Distribution::Ggx,
-        ),
-    ));
-    v
-}
 
 /// One in-plane point: sim total and by order, model total and components.
 struct Point {

@@ -4,8 +4,8 @@
 //! step 10, reflection and transmission, light on the front), and the
 //! directional albedo, for the default options against doubled nodes
 //! (64 outside, 32 in the cone of total reflection) and against doubled
-//! Fourier orders (96), for the presets and the hard sheets of
-//! docs/accuracy.md, in both face modes.
+//! Fourier orders (96), for every case of docs/accuracy.md (the presets,
+//! devA, devB and the spread of sheets), in both face modes.
 //!
 //! Printed per sheet: the largest relative change of a value (with the
 //! in-plane point where it happens), the RMS relative change, and the
@@ -17,29 +17,12 @@
 
 use paperbsdf_core::bsdf::albedo_from;
 use paperbsdf_core::geometry::in_plane_directions;
-use paperbsdf_core::presets::preset;
-use paperbsdf_core::{Bsdf, Colour, Distribution, FaceScattering, PaperParams};
+use paperbsdf_core::{Bsdf, FaceScattering, PaperParams};
 use paperbsdf_slab::{SlabBsdf, SlabOptions};
 
-/// A sheet of docs/accuracy.md's spread (its `paper` helper).
-fn sheet(d: f64, sigma_a: f64, sigma_s: f64, m: f64, dist_f: Distribution) -> PaperParams {
-    PaperParams {
-        name: None,
-        d,
-        sigma_a: Colour::Scalar(sigma_a),
-        sigma_s: Colour::Scalar(sigma_s),
-        g_f: 0.8,
-        g_b: -0.3,
-        w_b: 0.2,
-        eta_f: 1.5,
-        eta_b: 1.5,
-        m_f: m,
-        m_b: 0.3,
-        dist_f,
-        dist_b: Distribution::Ggx,
-        face_scattering: FaceScattering::Multiple,
-    }
-}
+// The cases of docs/accuracy.md, as the accuracy example has them.
+#[path = "../../sim/examples/support/cases.rs"]
+mod cases;
 
 /// In-plane values (mean over channels) and the points they belong to.
 fn in_plane(b: &SlabBsdf) -> (Vec<f64>, Vec<String>) {
@@ -70,16 +53,7 @@ fn albedos(b: &SlabBsdf) -> Vec<f64> {
 }
 
 fn main() {
-    let mut cases: Vec<(String, PaperParams)> = ["matte", "luster", "glossy"]
-        .iter()
-        .map(|n| (format!("preset-{n}"), preset(n).expect("preset")))
-        .collect();
-    cases.push(("thin-tissue".into(), sheet(0.03, 0.3, 40.0, 0.3, Distribution::Ggx)));
-    cases.push(("weak-scatter".into(), sheet(0.1, 0.5, 30.0, 0.3, Distribution::Ggx)));
-    cases.push((
-        "smooth-front".into(),
-        sheet(0.1, 0.5, 150.0, 0.05, Distribution::Beckmann),
-    ));
+    let cases = cases::cases();
     let base = SlabOptions::default();
     let variants = [
         (
