@@ -97,15 +97,13 @@
 //! forward peak at grazing incidence on smooth faces (luster's Beckmann
 //! 0.15 front at 75 degrees, 8% under the simulator at `theta_o = -80` with
 //! 32 orders; the model's default is therefore 48, `crate::SlabOptions`).
-//! That peak is narrower in azimuth than 48 orders resolve (at `theta_o =
-//! 80` it falls a hundredfold 10 degrees out of the plane), so it is not
-//! converged in the orders: the in-plane value at `theta_o = -80` grows by
-//! 1.6% from 48 to 64 orders, 2.1% to 96 and 1.2% more to 128
-//! (crates/slab/examples/convergence.rs: doubling the orders moves it
-//! 3.1%). Jackson's kernel (non-negative too, RMS width `pi / M` where
-//! Fejer's tails give 14 degrees at 48 orders) was tried: better for lobes
-//! broader than `pi / M`, worse for this one (3.8% on doubling), as its
-//! main lobe is wider than Fejer's.
+//! That peak is narrower in azimuth than 48 orders resolve, so it is not
+//! converged in the orders: doubling them moves the in-plane value at
+//! `theta_o = -80` by 3.1% (crates/slab/examples/convergence.rs). Jackson's
+//! kernel (non-negative too, RMS width `pi / M` where Fejer's tails give 14
+//! degrees at 48 orders) was tried and not kept: better for lobes broader
+//! than `pi / M`, worse for this one, as its main lobe is wider than
+//! Fejer's.
 //! The walk integrates with half the azimuth points per panel of Walter's
 //! projection (its kernels are integrated again over the intermediate
 //! directions; luster at 75 degrees: the same RMS error to 1e-4, build 15%
