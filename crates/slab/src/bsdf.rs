@@ -34,7 +34,9 @@
 //! `f = sum_m c_m cos(m phi)` with `phi` the azimuth difference of the
 //! propagation directions (`cos phi = -(wi_xy . wo_xy) / (|wi_xy| |wo_xy|)`:
 //! `phi = 0` is forward scattering, the mirror direction in reflection and
-//! the straight-through direction in transmission).
+//! the straight-through direction in transmission). A grey sheet (every
+//! colour channel the same medium) stores one channel and `eval` sums one
+//! series instead of three.
 //!
 //! **Between the nodes** `f` is interpolated linearly in `mu_i` and in `mu_o`
 //! (bilinear in the node pair of each cosine; constant below the smallest
@@ -205,13 +207,18 @@ impl SmoothSheet {
 /// the number of orders that matter for each node pair.
 #[derive(Clone, Debug, Default)]
 struct Tables {
-    /// `c_m[o][j]` at `(o n + j) M + m`.
-    c: [[Vec<Rgb>; 2]; 2],
+    /// Channel `k` of `c_m[o][j]` at `((o n + j) M + m) K + k`, with `K` =
+    /// [`Tables::channels`].
+    c: [[Vec<f64>; 2]; 2],
     /// Per `(o n + j)`: the orders `0..len` kept, the fewest whose dropped
     /// tail sums to at most [`ORDER_CUTOFF`] of the pair's largest
     /// coefficient (the same for a pair and its reciprocal, so truncation
     /// keeps reciprocity exact).
     len: [[Vec<u16>; 2]; 2],
+    /// Channels stored: 1 for a grey sheet (every colour channel has the
+    /// same medium, so one solve and equal tables: `eval` sums one series
+    /// instead of three), else 3.
+    channels: usize,
 }
 
 /// A pair's highest Fourier orders are dropped while the sum of their
@@ -226,8 +233,9 @@ const ORDER_CUTOFF: f64 = 1e-5;
 const TINY: f64 = 1e-200;
 
 impl Tables {
-    /// Truncates the orders of every node pair (`n` nodes, `orders` orders).
-    fn truncate(c: [[Vec<Rgb>; 2]; 2], n: usize, orders: usize) -> Tables {
+    /// Truncates the orders of every node pair (`n` nodes, `orders` orders)
+    /// and stores channel 0 alone when `grey` (all channels equal).
+    fn truncate(c: [[Vec<Rgb>; 2]; 2], n: usize, orders: usize, grey: bool) -> Tables {
         let mut c = c;
         let mut len: [[Vec<u16>; 2]; 2] = Default::default();
         for tab in c.iter_mut().flatten() {
@@ -283,7 +291,15 @@ impl Tables {
                 }
             }
         }
-        Tables { c, len: sym }
+        let channels = if grey { 1 } else { 3 };
+        let c = c.map(|side| {
+            side.map(|tab| {
+                tab.iter()
+                    .flat_map(|v| v.0.into_iter().take(channels))
+                    .collect::<Vec<f64>>()
+            })
+        });
+        Tables { c, len: sym, channels }
     }
 }
 
@@ -579,6 +595,41 @@ fn cos_phi(wi: DVec3, wo: DVec3) -> f64 {
     c.clamp(-1.0, 1.0)
 }
 
+/// The Fourier series `sum_m s_m cos(m phi)` (`c = cos phi`) of the four
+/// node pairs `pairs` of a table `t` with `K` channels and `mcount` orders
+/// per pair, weighted by `weights`, over orders `0..len`: per order the
+/// corners are weighted first (`s_m`), then the series is summed with
+/// `cos(m phi)` by the Chebyshev recurrence.
+#[inline(always)]
+fn fourier_sum<const K: usize>(
+    t: &[f64],
+    pairs: [usize; 4],
+    weights: [f64; 4],
+    mcount: usize,
+    len: usize,
+    c: f64,
+) -> [f64; K] {
+    let [r0, r1, r2, r3] = pairs.map(|p| &t[p * mcount * K..(p * mcount + len) * K]);
+    let [w0, w1, w2, w3] = weights;
+    let (mut c_prev, mut c_m) = (c, 1.0);
+    let mut acc = [0.0f64; K];
+    let rows = r0
+        .chunks_exact(K)
+        .zip(r1.chunks_exact(K))
+        .zip(r2.chunks_exact(K))
+        .zip(r3.chunks_exact(K));
+    for (((a, b), d), e) in rows {
+        for k in 0..K {
+            let s = a[k] * w0 + b[k] * w1 + d[k] * w2 + e[k] * w3;
+            acc[k] += s * c_m;
+        }
+        let next = 2.0 * c * c_m - c_prev;
+        c_prev = c_m;
+        c_m = next;
+    }
+    acc
+}
+
 impl SlabBsdf {
     /// Solves the sheet of `p` with the default [`SlabOptions`].
     pub fn new(p: &PaperParams) -> Result<SlabBsdf, SlabError> {
@@ -759,10 +810,12 @@ impl SlabBsdf {
                 crossing_shape(&g.mu, |m| paper.face_interface_reflectance(side, m))
             }
         });
+        // A grey sheet: every channel is the same solution.
+        let grey = solution_of.iter().all(|&k| k == solution_of[0]);
         let balance = balance_interpolation(&mut table, &mut direct, &g.mu, &g.w, &cross, &shape, m_count);
         let (table, direct) = (
-            Tables::truncate(table, n, m_count),
-            Tables::truncate(direct, n, m_count),
+            Tables::truncate(table, n, m_count, grey),
+            Tables::truncate(direct, n, m_count, grey),
         );
         let smooth = both_smooth.then(|| SmoothSheet {
             eta_f: specs[0].front.eta(),
@@ -896,29 +949,14 @@ impl SlabBsdf {
                 len = len.max(lens[*p] as usize);
             }
         }
-        let rows = pairs.map(|p| &t[p * mcount..p * mcount + len]);
-        // cos(m phi) by the Chebyshev recurrence, m = 0, 1, ...
-        let (mut c_prev, mut c_m) = (c, 1.0);
-        let mut acc = [0.0f64; 3];
-        for m in 0..len {
-            let mut s = [0.0f64; 3];
-            for (row, w) in rows.iter().zip(&weights) {
-                let v = &row[m].0;
-                s[0] += v[0] * w;
-                s[1] += v[1] * w;
-                s[2] += v[2] * w;
-            }
-            acc[0] += s[0] * c_m;
-            acc[1] += s[1] * c_m;
-            acc[2] += s[2] * c_m;
-            let next = 2.0 * c * c_m - c_prev;
-            c_prev = c_m;
-            c_m = next;
-        }
+        let acc = match tab.channels {
+            1 => Rgb::splat(fourier_sum::<1>(t, pairs, weights, mcount, len, c)[0]),
+            _ => Rgb(fourier_sum::<3>(t, pairs, weights, mcount, len, c)),
+        };
         let exit = if transmit { 1 - side } else { side };
         let g = shape_at(&self.shape[side], self.mu[0], wi.mu, wi.at)
             * shape_at(&self.shape[exit], self.mu[0], wo.mu, wo.at);
-        Rgb(acc) * g
+        acc * g
     }
 
     /// The factors by which the table's light crossing the face on `side`
@@ -950,7 +988,7 @@ impl SlabBsdf {
             .map(|t| {
                 t.c.iter()
                     .flatten()
-                    .map(|v| v.len() * std::mem::size_of::<Rgb>())
+                    .map(|v| v.len() * std::mem::size_of::<f64>())
                     .sum::<usize>()
                     + t.len.iter().flatten().map(|v| v.len() * 2).sum::<usize>()
             })

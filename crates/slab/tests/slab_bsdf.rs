@@ -523,6 +523,48 @@ fn components_sum_to_eval() {
     }
 }
 
+/// A grey sheet (one medium for all channels) stores and sums one channel
+/// instead of three (`Tables::channels`): its eval, every component and
+/// both sides, equals channel 0 of the same sheet with a different
+/// absorption in channels 1 and 2 (three channels stored, channel 0 the same
+/// medium and solve), at grazing, near-normal and off-node directions, in
+/// reflection and transmission. Both compute channel 0 with the same
+/// operations in the same order, so they agree to rounding.
+#[test]
+fn grey_sheet_is_the_rgb_sheet_channel() {
+    let grey = preset("luster").unwrap();
+    let Colour::Scalar(sa) = grey.sigma_a else {
+        panic!("luster's sigma_a is grey")
+    };
+    let rgb = PaperParams {
+        sigma_a: Colour::Rgb([sa, 2.0 * sa + 0.1, 3.0 * sa + 0.2]),
+        ..grey.clone()
+    };
+    let (g, c) = (SlabBsdf::new(&grey).unwrap(), SlabBsdf::new(&rgb).unwrap());
+    let mut n = 0;
+    for (ti, pi) in [(0.2, 0.0), (33.0, 0.4), (61.0, 1.1), (84.0, 2.9)] {
+        for (to, po) in [(0.5, 0.3), (17.0, 2.0), (47.0, 0.0), (79.0, 3.1), (88.0, 1.6)] {
+            for (si, so) in [(1.0, 1.0), (1.0, -1.0), (-1.0, -1.0), (-1.0, 1.0)] {
+                let (wi, wo) = (dir(ti, pi, si), dir(to, po, so));
+                let want = c.eval(wi, wo).0[0];
+                let got = g.eval(wi, wo);
+                assert!(
+                    (got.0[0] - want).abs() <= 1e-12 * want.abs().max(1e-12),
+                    "eval({ti},{pi},{si} -> {to},{po},{so}): grey {got:?}, rgb channel 0 {want}"
+                );
+                assert!(got.0[0] == got.0[1] && got.0[1] == got.0[2], "grey eval {got:?}");
+                for &k in g.components() {
+                    let (a, b) = (g.eval_component(wi, wo, k).0[0], c.eval_component(wi, wo, k).0[0]);
+                    assert!((a - b).abs() <= 1e-12 * b.abs().max(1e-12), "{k:?}: {a} vs {b}");
+                }
+                n += 1;
+            }
+        }
+    }
+    assert_eq!(n, 80);
+    assert!(g.memory_bytes() < c.memory_bytes());
+}
+
 #[test]
 fn bad_input_is_an_error() {
     let p = preset("matte").unwrap();
