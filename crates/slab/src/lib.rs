@@ -77,7 +77,7 @@ pub mod phase;
 pub mod quad;
 pub mod slab;
 
-pub use bsdf::{SlabBsdf, SlabOptions};
+pub use bsdf::{face_albedo, SlabBsdf, SlabOptions};
 pub use error::SlabError;
 pub use interface::{face_interface, smooth_boundary, Compensation, ProjectedFace, Projection};
 pub use layer::{Layer, SymmetricLayer};
