@@ -396,9 +396,10 @@ pub struct SlabBsdf {
     /// Per side and node: the factors that balance the interpolated tables
     /// ([`balance_interpolation`]).
     balance: [Vec<Rgb>; 2],
-    /// Per rough face and node: the analytic lobe's albedo ([`face_albedo`];
-    /// empty for a smooth face).
-    face_albedos: [Vec<f64>; 2],
+    /// Per rough face and node interval: the analytic lobe's albedo
+    /// ([`face_albedo`] at the nodes, [`cubic_at`] between them) as a cubic
+    /// in the interval's fraction ([`interval_cubics`]; empty for a smooth face).
+    face_polys: [Vec<[f64; 4]>; 2],
 }
 
 /// Panels per axis of [`face_albedo`]'s rule in the model's build (each
@@ -491,6 +492,32 @@ fn cubic_at(nodes: &[f64], values: &[f64], mu: f64) -> f64 {
         acc += l * values[a];
     }
     acc
+}
+
+/// [`cubic_at`] of `values` on each interval `[nodes[i], nodes[i + 1]]` as
+/// the monomial coefficients of a cubic in the fraction `t` of the interval
+/// (from its values at `t` = 0, 1/3, 2/3, 1: the cubic through four nodes is
+/// a cubic in `t`), so that `eval` and `sample` get it without divisions.
+fn interval_cubics(nodes: &[f64], values: &[f64]) -> Vec<[f64; 4]> {
+    nodes
+        .windows(2)
+        .map(|e| {
+            let v: [f64; 4] = std::array::from_fn(|k| cubic_at(nodes, values, e[0] + (e[1] - e[0]) * k as f64 / 3.0));
+            [
+                v[0],
+                0.5 * (-11.0 * v[0] + 18.0 * v[1] - 9.0 * v[2] + 2.0 * v[3]),
+                0.5 * (18.0 * v[0] - 45.0 * v[1] + 36.0 * v[2] - 9.0 * v[3]),
+                0.5 * (-9.0 * v[0] + 27.0 * v[1] - 27.0 * v[2] + 9.0 * v[3]),
+            ]
+        })
+        .collect()
+}
+
+/// A cubic of [`interval_cubics`] at [`locate`]'s `(i, t)`.
+#[inline]
+fn poly_at(polys: &[[f64; 4]], (i, t): (usize, f64)) -> f64 {
+    let c = &polys[i];
+    ((c[3] * t + c[2]) * t + c[1]) * t + c[0]
 }
 
 /// Points of the tabulated crossing shape per interval between nodes
@@ -843,7 +870,14 @@ impl SlabBsdf {
                 .map(|&mu| face_albedo(&paper, side, dist, m, mu, FACE_ALBEDO_PANELS))
                 .collect()
         });
-        let face_r_at = |side: Side, mu: f64| -> f64 { cubic_at(&g.mu, &face_albedos[side as usize], mu) };
+        let face_polys = face_albedos.each_ref().map(|a| {
+            if a.is_empty() {
+                Vec::new()
+            } else {
+                interval_cubics(&g.mu, a)
+            }
+        });
+        let face_r_at = |side: Side, mu: f64| -> f64 { poly_at(&face_polys[side as usize], locate(&g.mu, mu)) };
         let crossing = |side: Side| -> Vec<f64> {
             let s = side as usize;
             if paper.face_is_smooth(side) {
@@ -964,7 +998,7 @@ impl SlabBsdf {
             crossing: cross,
             shape,
             balance,
-            face_albedos,
+            face_polys,
         };
         for side in Side::BOTH {
             let (cells, albedo): (Vec<CellDensity>, Vec<f64>) =
@@ -1109,7 +1143,7 @@ impl SlabBsdf {
         if self.paper.face_is_smooth(side) {
             return self.paper.face_reflectance(side, mu);
         }
-        cubic_at(&self.mu, &self.face_albedos[side as usize], mu)
+        poly_at(&self.face_polys[side as usize], locate(&self.mu, mu))
     }
 
     /// Memory held by the tables and sampling densities, in bytes.
@@ -1132,7 +1166,7 @@ impl SlabBsdf {
             .sum();
         let shapes: usize = self.shape.iter().map(|g| g.len() * 8).sum();
         let balance: usize = self.balance.iter().map(|x| x.len() * std::mem::size_of::<Rgb>()).sum();
-        let corrections: usize = self.face_albedos.iter().map(|d| d.len() * 8).sum();
+        let corrections: usize = self.face_polys.iter().map(|d| d.len() * 32).sum();
         tables + cells + shapes + balance + corrections
     }
 
@@ -1148,7 +1182,7 @@ impl SlabBsdf {
         let surface = if self.paper.face_is_smooth(side) {
             0.0
         } else {
-            self.face_reflectance(side, mu)
+            poly_at(&self.face_polys[side as usize], wo.at)
         };
         let (j, t) = wo.at;
         let alb = &self.table_albedo[side as usize];
