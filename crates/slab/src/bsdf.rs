@@ -74,9 +74,9 @@
 //! nodes over the micro-normal ([`face_albedo`]) and interpolated by a
 //! cubic ([`SlabBsdf::face_reflectance`]).
 //! With them the table plus the face's reflectance closes to 3e-7 for
-//! non-absorbing sheets at any incidence, and the whole `eval` to 8e-5 from
-//! normal to 85 degrees (tests/slab_bsdf.rs; it was 1.15e-4 to 50 degrees
-//! with core's reflectance).
+//! non-absorbing sheets at any incidence, and the whole `eval` to 1.6e-5
+//! from normal to 85 degrees (tests/slab_bsdf.rs; it was 1.15e-4 to 50
+//! degrees with core's reflectance).
 //!
 //! **Sampling.** A mixture of (a) the lit face's visible-normal sampling
 //! (core's), (b) its delta lobes, and (c) the table: for each node of `wo`, a
@@ -403,8 +403,11 @@ pub struct SlabBsdf {
 }
 
 /// Panels per axis of [`face_albedo`]'s rule in the model's build (each
-/// with [`FACE_ALBEDO_POINTS`] Gauss-Legendre points).
-pub const FACE_ALBEDO_PANELS: usize = 16;
+/// with [`FACE_ALBEDO_POINTS`] Gauss-Legendre points): within about 4e-5 of
+/// 64 panels at grazing incidence and 1e-6 elsewhere (16 panels: up to
+/// 1.1e-4 at grazing, and the whole `eval` of tests/slab_bsdf.rs closed to
+/// 7.9e-5 instead of 1.6e-5); 64 integrals per sheet, about 1 ms each.
+pub const FACE_ALBEDO_PANELS: usize = 32;
 /// Gauss-Legendre points per panel of [`face_albedo`]'s rule.
 pub const FACE_ALBEDO_POINTS: usize = 4;
 
@@ -472,9 +475,8 @@ pub fn face_albedo(paper: &PaperBsdf, side: Side, dist: Distribution, m: f64, mu
 /// `values` (at the ascending `nodes`) at `mu` by the cubic through the
 /// four nodes around `mu` (Lagrange; the first or last four at the ends),
 /// constant outside `[nodes[0], nodes[n - 1]]`: a face's albedo is smooth
-/// in `mu`, and linear interpolation between the 32 nodes left up to 1e-4
-/// at grazing angles (the coated Beckmann 0.25 front of tests/slab_bsdf.rs
-/// at 85 degrees).
+/// in `mu`, and linear interpolation between the 32 nodes left 1.2e-4 (the
+/// GGX 0.2 front of tests/slab_bsdf.rs at 55 degrees; the cubic 1.6e-5).
 fn cubic_at(nodes: &[f64], values: &[f64], mu: f64) -> f64 {
     let n = nodes.len();
     let mu = mu.clamp(nodes[0], nodes[n - 1]);

@@ -284,9 +284,9 @@ fn grid_albedo(f: impl Fn(DVec3) -> f64, nodes: &[f64], per: usize, split: usize
 /// and nearly so in `mu_o`). The analytic lobe (component `surface`) is
 /// integrated by the same rule over `wo`, finer ([`SURFACE_SPLIT`],
 /// [`SURFACE_PHI`]: doubling both moves no sum by 1e-7), which checks
-/// `face_reflectance` independently (within 1e-4; measured 7.9e-5, at 85
-/// degrees), and table plus lobe, the whole `eval`, must be 1 within 1e-4
-/// at every angle (measured 7.9e-5). With core's tabulated reflectance in
+/// `face_reflectance` independently (within 1e-4; measured 1.6e-5), and
+/// table plus lobe, the whole `eval`, must be 1 within 1e-4 at every angle
+/// (measured 1.6e-5). With core's tabulated reflectance in
 /// place of `face_albedo`, which differs from its own lobe's integral by
 /// 1e-4 at normal incidence (the coated Beckmann 0.25 front) and up to
 /// 1.7e-3 at grazing, this was 1.15e-4 up to 50 degrees.
