@@ -425,11 +425,13 @@ pub const FACE_ALBEDO_POINTS: usize = 4;
 /// `phi` on `[0, pi]` (the lobe is even in `phi`), `panels` x
 /// [`FACE_ALBEDO_POINTS`] points per axis. The lobe is `eval`'s own, so this
 /// is the energy `eval` returns, independent of core's tabulated
-/// reflectance. 0 for a face without microfacets.
-pub fn face_albedo(paper: &PaperBsdf, side: Side, dist: Distribution, m: f64, mu: f64, panels: usize) -> f64 {
-    if paper.face_is_smooth(side) {
+/// reflectance. The distribution and `m` are the face's own
+/// (`PaperBsdf::face_microfacet`); 0 for a face without microfacets.
+pub fn face_albedo(paper: &PaperBsdf, side: Side, mu: f64, panels: usize) -> f64 {
+    let Some(mf) = paper.face_microfacet(side) else {
         return 0.0;
-    }
+    };
+    let (dist, m) = (mf.dist, mf.alpha);
     let (x, w) = gauss_legendre_01(FACE_ALBEDO_POINTS);
     let mu = mu.clamp(1e-9, 1.0);
     let wi = side.local(DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu));
@@ -862,24 +864,25 @@ impl SlabBsdf {
         // The analytic lobe's albedo at the nodes, integrated directly
         // ([`face_albedo`]): the table is balanced against the energy
         // `eval`'s own lobe takes (module doc, "Energy").
-        let face_params = [(p.dist_f, p.m_f), (p.dist_b, p.m_b)];
-        let face_albedos = [Side::Front, Side::Back].map(|side| {
+        let face_polys = [Side::Front, Side::Back].map(|side| {
             if paper.face_is_smooth(side) {
                 return Vec::new();
             }
-            let (dist, m) = face_params[side as usize];
-            g.mu.par_iter()
-                .map(|&mu| face_albedo(&paper, side, dist, m, mu, FACE_ALBEDO_PANELS))
-                .collect()
+            let albedos: Vec<f64> =
+                g.mu.par_iter()
+                    .map(|&mu| face_albedo(&paper, side, mu, FACE_ALBEDO_PANELS))
+                    .collect();
+            interval_cubics(&g.mu, &albedos)
         });
-        let face_polys = face_albedos.each_ref().map(|a| {
-            if a.is_empty() {
-                Vec::new()
+        // What `eval` adds outside the table: the rough lobe's albedo, or a
+        // smooth face's delta reflectance (`SlabBsdf::face_reflectance`).
+        let face_r_at = |side: Side, mu: f64| -> f64 {
+            if paper.face_is_smooth(side) {
+                paper.face_reflectance(side, mu)
             } else {
-                interval_cubics(&g.mu, a)
+                poly_at(&face_polys[side as usize], locate(&g.mu, mu))
             }
-        });
-        let face_r_at = |side: Side, mu: f64| -> f64 { poly_at(&face_polys[side as usize], locate(&g.mu, mu)) };
+        };
         let crossing = |side: Side| -> Vec<f64> {
             let s = side as usize;
             if paper.face_is_smooth(side) {
@@ -956,13 +959,7 @@ impl SlabBsdf {
         }
         // The crossing shapes of the faces (module doc, "Energy"): the light
         // the lit face lets in, `1 - r`, with `r` what `eval` adds analytically.
-        let shape = [Side::Front, Side::Back].map(|side| {
-            if paper.face_is_smooth(side) {
-                crossing_shape(&g.mu, |m| paper.face_reflectance(side, m))
-            } else {
-                crossing_shape(&g.mu, |m| face_r_at(side, m))
-            }
-        });
+        let shape = [Side::Front, Side::Back].map(|side| crossing_shape(&g.mu, |m| face_r_at(side, m)));
         // A grey sheet: every channel is the same solution.
         let grey = solution_of.iter().all(|&k| k == solution_of[0]);
         let balance = balance_interpolation(&mut table, &mut direct, &g.mu, &g.w, &cross, &shape, m_count);
@@ -1139,8 +1136,8 @@ impl SlabBsdf {
     /// on `side` for light from outside at cosine `mu` (the energy `eval`'s
     /// [`Component::Surface`] takes, and what the table is balanced
     /// against): the lobe's integral at the nodes ([`face_albedo`]),
-    /// interpolated by the cubic through the four nearest nodes; for a smooth face its delta's Fresnel
-    /// reflectance.
+    /// interpolated by the cubic through the four nearest nodes; for a
+    /// smooth face its delta's Fresnel reflectance.
     pub fn face_reflectance(&self, side: Side, mu: f64) -> f64 {
         if self.paper.face_is_smooth(side) {
             return self.paper.face_reflectance(side, mu);
@@ -1168,8 +1165,12 @@ impl SlabBsdf {
             .sum();
         let shapes: usize = self.shape.iter().map(|g| g.len() * 8).sum();
         let balance: usize = self.balance.iter().map(|x| x.len() * std::mem::size_of::<Rgb>()).sum();
-        let corrections: usize = self.face_polys.iter().map(|d| d.len() * 32).sum();
-        tables + cells + shapes + balance + corrections
+        let face_polys: usize = self
+            .face_polys
+            .iter()
+            .map(|d| d.len() * std::mem::size_of::<[f64; 4]>())
+            .sum();
+        tables + cells + shapes + balance + face_polys
     }
 
     /// The lobe probabilities at `wo`: (surface lobe, delta lobes, table).

@@ -609,7 +609,7 @@ fn face_albedo_is_fresnel_when_smooth_and_converged() {
     for d in [Distribution::Ggx, Distribution::Beckmann] {
         let paper = mk(1.5, 0.003, d);
         for mu in [1.0, 0.7, 0.3] {
-            let a = face_albedo(&paper, Side::Front, d, 0.003, mu, FACE_ALBEDO_PANELS);
+            let a = face_albedo(&paper, Side::Front, mu, FACE_ALBEDO_PANELS);
             let f = fresnel_dielectric(mu, 1.5);
             assert!((a - f).abs() < 1e-4, "{d:?} m 0.003 mu {mu}: {a} vs Fresnel {f}");
         }
@@ -622,8 +622,8 @@ fn face_albedo_is_fresnel_when_smooth_and_converged() {
     ] {
         let paper = mk(eta, m, d);
         for mu in [1.0, 0.5, 0.1, 0.03, 0.005] {
-            let a = face_albedo(&paper, Side::Front, d, m, mu, FACE_ALBEDO_PANELS);
-            let fine = face_albedo(&paper, Side::Front, d, m, mu, 4 * FACE_ALBEDO_PANELS);
+            let a = face_albedo(&paper, Side::Front, mu, FACE_ALBEDO_PANELS);
+            let fine = face_albedo(&paper, Side::Front, mu, 4 * FACE_ALBEDO_PANELS);
             assert!(
                 (a - fine).abs() < 5e-5,
                 "{d:?} {m} mu {mu}: {a} vs {fine} with 4x the panels"

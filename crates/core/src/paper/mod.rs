@@ -566,7 +566,13 @@ impl PaperBsdf {
     /// Whether the face on `side` has no microfacets (smooth or index-matched:
     /// its reflection is a delta lobe of reflectance [`PaperBsdf::face_reflectance`]).
     pub fn face_is_smooth(&self, side: Side) -> bool {
-        self.faces[side].microfacet().is_none()
+        self.face_microfacet(side).is_none()
+    }
+
+    /// The microfacet distribution (family and roughness `m`) of the face on
+    /// `side`; `None` for a face without microfacets (smooth or index-matched).
+    pub fn face_microfacet(&self, side: Side) -> Option<crate::microfacet::Microfacet> {
+        self.faces[side].microfacet()
     }
 
     /// Albedo of the single-scattering term (reflection plus transmission) per
