@@ -69,8 +69,7 @@
 //!
 //! The face's reflectance `r` in both is not core's tabulated one (which
 //! differs from the integral of its own lobe by up to 1e-4 at normal
-//! incidence and 1.7e-3 at grazing: its masking is tabulated on 65 nodes in
-//! `sqrt(mu)`) but the lobe's albedo as `eval` returns it, integrated at the
+//! incidence and 1.7e-3 at grazing, examples/face_albedo.rs) but the lobe's albedo as `eval` returns it, integrated at the
 //! nodes over the micro-normal ([`face_albedo`]) and interpolated by a
 //! cubic ([`SlabBsdf::face_reflectance`]).
 //! With them the table plus the face's reflectance closes to 3e-7 for
@@ -403,10 +402,11 @@ pub struct SlabBsdf {
 }
 
 /// Panels per axis of [`face_albedo`]'s rule in the model's build (each
-/// with [`FACE_ALBEDO_POINTS`] Gauss-Legendre points): within about 4e-5 of
-/// 64 panels at grazing incidence and 1e-6 elsewhere (16 panels: up to
-/// 1.1e-4 at grazing, and the whole `eval` of tests/slab_bsdf.rs closed to
-/// 7.9e-5 instead of 1.6e-5); 64 integrals per sheet, about 1 ms each.
+/// with [`FACE_ALBEDO_POINTS`] Gauss-Legendre points): within 4.1e-5 of
+/// 128 panels at grazing incidence (`mu` <= 0.05) and 7e-6 above, where 16
+/// panels were up to 1.0e-4 off (examples/face_albedo.rs; with 16, the whole
+/// `eval` of tests/slab_bsdf.rs's energy test closed to 7.9e-5 instead of
+/// 1.6e-5); 64 integrals per sheet, about 1 ms each.
 pub const FACE_ALBEDO_PANELS: usize = 32;
 /// Gauss-Legendre points per panel of [`face_albedo`]'s rule.
 pub const FACE_ALBEDO_POINTS: usize = 4;
@@ -477,8 +477,9 @@ pub fn face_albedo(paper: &PaperBsdf, side: Side, mu: f64, panels: usize) -> f64
 /// `values` (at the ascending `nodes`) at `mu` by the cubic through the
 /// four nodes around `mu` (Lagrange; the first or last four at the ends),
 /// constant outside `[nodes[0], nodes[n - 1]]`: a face's albedo is smooth
-/// in `mu`, and linear interpolation between the 32 nodes left 1.2e-4 (the
-/// GGX 0.2 front of tests/slab_bsdf.rs at 55 degrees; the cubic 1.6e-5).
+/// in `mu`, and linear interpolation of the node values is up to 1.7e-4 off
+/// between the 32 nodes, the cubic 1.0e-5 (a GGX 0.2 front;
+/// examples/face_albedo.rs).
 fn cubic_at(nodes: &[f64], values: &[f64], mu: f64) -> f64 {
     let n = nodes.len();
     let mu = mu.clamp(nodes[0], nodes[n - 1]);
