@@ -1,7 +1,9 @@
 //! Convergence of the model `slab` in its discretisation, measured where the
-//! renderer sees it: `SlabBsdf::eval` at the in-plane directions of
-//! docs/accuracy.md (`theta_i` 0, 30, 60, 75 degrees, `theta_o = -80..80`
-//! step 10, reflection and transmission, light on the front), and the
+//! renderer sees it: `SlabBsdf::eval` at in-plane directions (`theta_i` 0,
+//! 2.5, 30, 45, 60, 75 degrees, `theta_o = -80..80` step 5 and +-2.5: the
+//! points of docs/accuracy.md, the points between them and the last
+//! interval of nodes near the normal, 4.85 degrees wide; reflection and
+//! transmission, light on the front), and the
 //! directional albedo, for the default options against doubled nodes
 //! (64 outside, 32 in the cone of total reflection) and against doubled
 //! Fourier orders (96), for every case of docs/accuracy.md (the presets,
@@ -28,10 +30,10 @@ mod cases;
 fn in_plane(b: &SlabBsdf) -> (Vec<f64>, Vec<String>) {
     let mut v = Vec::new();
     let mut at = Vec::new();
-    for ti in [0.0, 30.0, 60.0, 75.0] {
+    for ti in [0.0, 2.5, 30.0, 45.0, 60.0, 75.0] {
         for tr in [false, true] {
-            for k in -8..=8 {
-                let to = 10.0 * k as f64;
+            let steps = (-16..=16).map(|k| 5.0 * k as f64).chain([-2.5, 2.5]);
+            for to in steps {
                 let (wi, wo) = in_plane_directions(ti, to, tr);
                 v.push(b.eval(wi, wo).mean());
                 at.push(format!("{ti} {} {to}", if tr { "T" } else { "R" }));

@@ -61,11 +61,14 @@
 //! also make `eval` cheaper. Near the pole (the last interval, between the
 //! node before `mu = 1` and `mu = 1`, 4.85 degrees with 32 nodes) the orders
 //! `m >= 1` of the node before it are carried with weight `rho^m`, `rho =
-//! sin theta / sin theta_{n-2}`, as a smooth function's on the sphere fall
-//! (`pole_factors`); linear weights in `mu` let every order fall like
-//! `theta^2`, which halved order 1 there (a thin sheet's transmission 2.5
-//! degrees from the normal: 8% off, of opposite signs either side; now 2.5%
-//! against twice the nodes). The Fourier sum can ring below zero for lobes
+//! sin theta / sin theta_{n-2}`, as a smooth function's on the sphere fall,
+//! and interpolated linearly in the other direction's `mu` (`pole_corners`;
+//! order 0 stays the triangles'). Linear weights in `mu` let every order
+//! fall like `theta^2`, which halved order 1 there (a thin sheet's
+//! transmission 2.5 degrees from the normal: 8% off, of opposite signs
+//! either side; now 2.5% against twice the nodes), and the triangles took
+//! the orders `m >= 1` of light arriving near the normal from one node of
+//! `mu_o` (7% off at 10 degrees, now 3.6%). The Fourier sum can ring below zero for lobes
 //! narrower than the orders resolve: `eval` returns `max(f, 0)` per channel.
 //!
 //! **Energy.** The solver conserves energy in its quadrature (`R + T` at a
@@ -883,13 +886,11 @@ fn cos_phi(wi: DVec3, wo: DVec3) -> f64 {
     c.clamp(-1.0, 1.0)
 }
 
-/// The Fourier series `s_0 + scale sum_{m >= 1} s_m r^m cos(m phi)` (`c =
-/// cos phi`) of the three node pairs `pairs` of a table `t` with `K`
-/// channels and `mcount` orders per pair, weighted by `weights`, over orders
-/// `0..len`: per order the corners are weighted first (`s_m`), then the
-/// series is summed with `r^m cos(m phi)` by the recurrence `a_{m+1} = 2 r c
-/// a_m - r^2 a_{m-1}` (Chebyshev's for `r = 1`; `r < 1` and `scale` near the
-/// pole, [`pole_factors`]).
+/// The Fourier series `sum_m s_m cos(m phi)` (`c = cos phi`) of the three
+/// node pairs `pairs` of a table `t` with `K` channels and `mcount` orders
+/// per pair, weighted by `weights`, over orders `0..len`: per order the
+/// corners are weighted first (`s_m`), then the series is summed with
+/// `cos(m phi)` by the Chebyshev recurrence.
 #[inline(always)]
 fn fourier_sum<const K: usize>(
     t: &[f64],
@@ -898,77 +899,114 @@ fn fourier_sum<const K: usize>(
     mcount: usize,
     len: usize,
     c: f64,
-    (r, scale): (f64, f64),
 ) -> [f64; K] {
     let [r0, r1, r2] = pairs.map(|p| &t[p * mcount * K..(p * mcount + len) * K]);
     let [w0, w1, w2] = weights;
+    let (mut c_prev, mut c_m) = (c, 1.0);
     let mut acc = [0.0f64; K];
     let rows = r0.chunks_exact(K).zip(r1.chunks_exact(K)).zip(r2.chunks_exact(K));
-    let mut rows = rows.take(len);
-    let Some(((a, b), d)) = rows.next() else {
-        return acc;
-    };
-    let mut order_0 = [0.0f64; K];
-    for k in 0..K {
-        order_0[k] = a[k] * w0 + b[k] * w1 + d[k] * w2;
-    }
-    let (rc, r2) = (r * c, r * r);
-    let (mut a_prev, mut a_m) = (1.0, rc);
     for ((a, b), d) in rows {
         for k in 0..K {
             let s = a[k] * w0 + b[k] * w1 + d[k] * w2;
-            acc[k] += s * a_m;
+            acc[k] += s * c_m;
+        }
+        let next = 2.0 * c * c_m - c_prev;
+        c_prev = c_m;
+        c_m = next;
+    }
+    acc
+}
+
+/// The table near the pole ([`pole_corners`]): order 0 from the triangles'
+/// three node pairs `pairs` and `weights` (as [`fourier_sum`]), the orders
+/// `m >= 1` from the two node pairs of `pole` with their weights, summed with
+/// `r^m cos(m phi)` by the recurrence `a_{m+1} = 2 r c a_m - r^2 a_{m-1}`.
+#[allow(clippy::too_many_arguments)]
+fn fourier_sum_pole<const K: usize>(
+    t: &[f64],
+    pairs: [usize; 3],
+    weights: [f64; 3],
+    pole: &PoleCorners,
+    mcount: usize,
+    len: usize,
+    c: f64,
+) -> [f64; K] {
+    let mut acc = [0.0f64; K];
+    for (p, w) in pairs.iter().zip(&weights) {
+        for (k, a) in acc.iter_mut().enumerate() {
+            *a += w * t[p * mcount * K + k];
+        }
+    }
+    let (rc, r2) = (pole.r * c, pole.r * pole.r);
+    let (mut a_prev, mut a_m) = (1.0, rc);
+    for m in 1..len {
+        for (k, a) in acc.iter_mut().enumerate() {
+            let s: f64 = pole
+                .pairs
+                .iter()
+                .zip(&pole.weights)
+                .map(|(p, w)| w * t[(p * mcount + m) * K + k])
+                .sum();
+            *a += s * a_m;
         }
         let next = 2.0 * rc * a_m - r2 * a_prev;
         a_prev = a_m;
         a_m = next;
     }
-    for k in 0..K {
-        acc[k] = order_0[k] + scale * acc[k];
-    }
     acc
 }
 
-/// The orders `m >= 1` near the pole (module doc, "Between the nodes"):
-/// `(r, scale)` for [`fourier_sum`]. On the sphere a smooth `f` has Fourier
-/// coefficients `c_m ~ sin^m theta` as `theta -> 0`, and the table's orders
-/// `m >= 1` vanish at the node `mu = 1`; linear weights in `mu` across the
-/// last interval would make every order fall like `1 - mu ~ theta^2 / 2`,
-/// halving order 1 in the middle of it (a thin sheet's transmission seen 2.5
-/// degrees from the normal was 8% off, both signs of the azimuth). In the
-/// last interval the corners at the node before it carry their orders `m >=
-/// 1` with weight `rho^m`, `rho = sin theta / sin theta_{n-2}`, instead of
-/// their linear weights (whose sum `scale` divides out): `r = rho_o rho_i`
-/// (1 outside the last interval), `scale = 1 / W` with `W` the weight of the
-/// corners that carry orders `m >= 1`. Symmetric in the two directions, so
-/// reciprocity is kept; order 0, hence the albedo, is unchanged.
+/// The node pairs and weights of the orders `m >= 1` near the pole (module
+/// doc, "Between the nodes"), and `r` of [`fourier_sum_pole`].
+#[derive(Clone, Copy, Debug)]
+struct PoleCorners {
+    pairs: [usize; 2],
+    weights: [f64; 2],
+    r: f64,
+}
+
+/// The orders `m >= 1` when either direction is in the last interval of
+/// nodes (between the node before `mu = 1` and `mu = 1`), or `None`. On the
+/// sphere a smooth `f` has Fourier coefficients `c_m ~ sin^m theta` as
+/// `theta -> 0`, and the table's orders `m >= 1` vanish at the node `mu = 1`;
+/// linear weights in `mu` across the last interval would make every order
+/// fall like `1 - mu ~ theta^2 / 2`, halving order 1 in the middle of it.
+/// There the orders `m >= 1` of the node before it are carried with weight
+/// `rho^m`, `rho = sin theta / sin theta_{n-2}`, and interpolated linearly in
+/// the other direction's `mu` (the triangles would take them from one node
+/// of it: 7% off at 2.5 degrees' incidence on a thin sheet). Symmetric in
+/// the two directions, so reciprocity is kept; order 0, hence the albedo, is
+/// the triangles'.
 #[inline]
-fn pole_factors(mu: &[f64], wi: Place, wo: Place, corners: [(usize, usize); 3], weights: [f64; 3]) -> (f64, f64) {
+fn pole_corners(mu: &[f64], wi: Place, wo: Place) -> Option<PoleCorners> {
     let n = mu.len();
+    let last = n - 2;
     let rho = |p: Place| {
-        if p.at.0 == n - 2 && p.at.1 > 0.0 {
-            ((1.0 - p.mu * p.mu).max(0.0) / (1.0 - mu[n - 2] * mu[n - 2]))
+        (p.at.0 == last && p.at.1 > 0.0).then(|| {
+            ((1.0 - p.mu * p.mu).max(0.0) / (1.0 - mu[last] * mu[last]))
                 .sqrt()
                 .min(1.0)
-        } else {
-            1.0
-        }
+        })
     };
-    let r = rho(wi) * rho(wo);
-    if r == 1.0 {
-        return (1.0, 1.0);
-    }
-    let (o, j) = (wo.at.0, wi.at.0);
-    let w: f64 = corners
-        .iter()
-        .zip(&weights)
-        .filter(|((a, b), _)| o + a < n - 1 && j + b < n - 1)
-        .map(|(_, w)| w)
-        .sum();
-    if w > 0.0 {
-        (r, 1.0 / w)
-    } else {
-        (r, 0.0)
+    let ((j, tj), (o, to)) = (wi.at, wo.at);
+    let pair = |a: usize, b: usize| a * n + b;
+    match (rho(wi), rho(wo)) {
+        (None, None) => None,
+        (Some(ri), None) => Some(PoleCorners {
+            pairs: [pair(o, last), pair(o + 1, last)],
+            weights: [1.0 - to, to],
+            r: ri,
+        }),
+        (None, Some(ro)) => Some(PoleCorners {
+            pairs: [pair(last, j), pair(last, j + 1)],
+            weights: [1.0 - tj, tj],
+            r: ro,
+        }),
+        (Some(ri), Some(ro)) => Some(PoleCorners {
+            pairs: [pair(last, last), pair(last, last)],
+            weights: [1.0, 0.0],
+            r: ri * ro,
+        }),
     }
 }
 
@@ -1326,10 +1364,22 @@ impl SlabBsdf {
                 len = len.max(lens[*p] as usize);
             }
         }
-        let pole = pole_factors(&self.mu, wi, wo, corners, weights);
-        let acc = match tab.channels {
-            1 => Rgb::splat(fourier_sum::<1>(t, pairs, weights, mcount, len, c, pole)[0]),
-            _ => Rgb(fourier_sum::<3>(t, pairs, weights, mcount, len, c, pole)),
+        let acc = match pole_corners(&self.mu, wi, wo) {
+            None => match tab.channels {
+                1 => Rgb::splat(fourier_sum::<1>(t, pairs, weights, mcount, len, c)[0]),
+                _ => Rgb(fourier_sum::<3>(t, pairs, weights, mcount, len, c)),
+            },
+            Some(pole) => {
+                for (p, w) in pole.pairs.iter().zip(&pole.weights) {
+                    if *w != 0.0 {
+                        len = len.max(lens[*p] as usize);
+                    }
+                }
+                match tab.channels {
+                    1 => Rgb::splat(fourier_sum_pole::<1>(t, pairs, weights, &pole, mcount, len, c)[0]),
+                    _ => Rgb(fourier_sum_pole::<3>(t, pairs, weights, &pole, mcount, len, c)),
+                }
+            }
         };
         let exit = if transmit { 1 - side } else { side };
         let (pi, fi) = shape_place(self.mu[0], wi.mu, wi.at);

@@ -674,15 +674,21 @@ fn bad_input_is_an_error() {
 
 /// Near the normal (inside the last interval of nodes, `theta < 4.85`
 /// degrees with 32 nodes) the table's orders `m >= 1` follow `sin^m theta`,
-/// as a smooth function's on the sphere do (`pole_factors` in src/bsdf.rs),
-/// so the transmission of a thin sheet with unequal faces, lit at 30
-/// degrees, agrees with the same sheet on twice the nodes (whose last
-/// interval ends at 2.4 degrees) within 1.5% on both sides of the normal
-/// and both sides of incidence (measured 0.75%). Linear weights in `mu`,
-/// which make every order fall like `theta^2` and so halve order 1 in the
-/// middle of the interval, were 3.2% apart here (and 8% for the accuracy
-/// tables' thin tissue at 2.5 degrees, of opposite signs either side of the
-/// normal).
+/// as a smooth function's on the sphere do, interpolated in the other
+/// direction's `mu` (`pole_corners` in src/bsdf.rs). The transmission of a
+/// thin sheet with unequal faces agrees with the same sheet on twice the
+/// nodes (whose last interval ends at 2.4 degrees), on both sides of the
+/// normal and both sides of incidence:
+/// - lit at 30 degrees, seen within 4.5 degrees of the normal: within 1.5%
+///   (measured 0.59%). Linear weights in `mu`, which make every order fall
+///   like `theta^2` and so halve order 1 in the middle of the interval,
+///   were 3.2% apart (and 8% for the accuracy tables' thin tissue at 2.5
+///   degrees, of opposite signs either side of the normal);
+/// - lit at 2.5 degrees, seen 5 to 10 degrees off the normal: within 3.5%
+///   (measured 2.84%; 4.29% when the orders `m >= 1` came from the
+///   triangles' one node of `mu_o` in the column before the pole). What is
+///   left is the 32 nodes' resolution of a lobe a few degrees wide there:
+///   128 nodes agree with 64 within 0.6%.
 #[test]
 fn transmission_near_the_normal_converges() {
     let p = cases().into_iter().find(|(n, _)| *n == "thin-tissue").unwrap().1;
@@ -697,7 +703,7 @@ fn transmission_near_the_normal_converges() {
         },
     )
     .unwrap();
-    let mut worst = 0.0f64;
+    let (mut worst, mut worst_in) = (0.0f64, 0.0f64);
     for side in [1.0, -1.0] {
         for t in [-4.5, -3.6, -2.7, -1.8, -0.9, 0.9, 1.8, 2.7, 3.6, 4.5] {
             let wi = dir(30.0, PI, side);
@@ -708,6 +714,22 @@ fn transmission_near_the_normal_converges() {
             worst = worst.max(e);
             assert!(e < 0.015, "side {side}, theta_o {t}: {x} with 32 nodes, {y} with 64");
         }
+        // Lit near the normal, seen off it.
+        for t in [-10.0, -7.5, -5.0, 5.0, 7.5, 10.0] {
+            let wi = dir(2.5, PI, side);
+            let wo = dir(t, 0.0, -side);
+            let (x, y) = (b0.eval(wi, wo).mean(), b1.eval(wi, wo).mean());
+            let e = (x / y - 1.0).abs();
+            worst_in = worst_in.max(e);
+            assert!(
+                e < 0.035,
+                "side {side}, lit at 2.5, theta_o {t}: {x} with 32 nodes, {y} with 64"
+            );
+        }
     }
-    eprintln!("near the normal: 32 against 64 nodes within {:.2}%", 100.0 * worst);
+    eprintln!(
+        "near the normal: 32 against 64 nodes within {:.2}% (seen), {:.2}% (lit)",
+        100.0 * worst,
+        100.0 * worst_in
+    );
 }
