@@ -50,15 +50,17 @@
 //! against the simulator: docs/accuracy_slab.md.
 //!
 //! **What is missing for issue 13.** Lobes narrower than the grid, whose
-//! peak values move by up to 4.4% when the nodes or the orders are doubled
+//! peak values move by up to 10.5% when the nodes or the orders are doubled
 //! (examples/convergence.rs): a coated front smoother than the grid (the
 //! glossy preset's Beckmann 0.04, devB's 0.08: the face's own reflection is
-//! analytic, but the light the coating/base boundary returns through it at
-//! normal incidence is projected on 32 nodes), and the walk's forward
+//! analytic, but the light the coating/base boundary returns through it
+//! near normal incidence is projected on 32 nodes), and the walk's forward
 //! reflection at grazing incidence on a smooth face (narrower in azimuth
 //! than 48 orders, [`interface`]); a thin sheet's unscattered transmission
-//! moves by up to 1.4% in its flanks (its peak, interpolated along the
-//! table's diagonal since 2026-12-05, by 0.1%); further analytic parts
+//! moves by up to 1.4% in its flanks (linear interpolation in `mu` across
+//! their bend) and by 3.6% when lit within the last interval of nodes
+//! (4.85 degrees from the normal; its peak, interpolated along the table's
+//! diagonal since 2026-12-05, by 0.1%); further analytic parts
 //! (unscattered transmission through rough faces, exact single scattering
 //! as its own term: the tables hold every scattering order, so `slab` has
 //! no separate `single` component). The projected faces' R/T split (1e-3
