@@ -68,8 +68,9 @@
 //! transmission 2.5 degrees from the normal: 8% off, of opposite signs
 //! either side; now 2.5% against twice the nodes), and the triangles took
 //! the orders `m >= 1` of light arriving near the normal from one node of
-//! `mu_o` (7% off at 10 degrees, now 3.6%). The Fourier sum can ring below zero for lobes
-//! narrower than the orders resolve: `eval` returns `max(f, 0)` per channel.
+//! `mu_o` (7% off at 10 degrees, now 3.6%). The Fourier sum can ring below
+//! zero for lobes narrower than the orders resolve: `eval` returns `max(f,
+//! 0)` per channel.
 //!
 //! **Energy.** The solver conserves energy in its quadrature (`R + T` at a
 //! node `j` is `2 pi sum_o w_o mu_o c_0[o][j]` plus the analytic face, 1
@@ -96,9 +97,10 @@
 //!
 //! The face's reflectance `r` in both is not core's tabulated one (which
 //! differs from the integral of its own lobe by up to 1e-4 at normal
-//! incidence and 1.7e-3 at grazing, examples/face_albedo.rs) but the lobe's albedo as `eval` returns it, integrated at the
-//! nodes over the micro-normal ([`face_albedo`]) and interpolated by a
-//! cubic ([`SlabBsdf::face_reflectance`]).
+//! incidence and 1.7e-3 at grazing, examples/face_albedo.rs) but the lobe's
+//! albedo as `eval` returns it, integrated at the nodes over the
+//! micro-normal ([`face_albedo`]) and interpolated by a cubic
+//! ([`SlabBsdf::face_reflectance`]).
 //! With them the table plus the face's reflectance closes to 9e-6 for
 //! non-absorbing sheets at any incidence (3e-7 with bilinear weights, 6e-4
 //! with the triangles and no ridge ratios), and the whole `eval` to 1.6e-5
@@ -591,7 +593,12 @@ fn crossing_shape(mu: &[f64], r: impl Fn(f64) -> f64) -> Vec<f64> {
 /// [`locate`] (linear between the points of [`crossing_shape`]).
 #[inline]
 fn shape_at(g: &[f64], mu0: f64, mu: f64, at: (usize, f64)) -> f64 {
-    let (p, f) = shape_place(mu0, mu, at);
+    shape_value(g, shape_place(mu0, mu, at))
+}
+
+/// A crossing shape at [`shape_place`]'s `(p, f)`.
+#[inline]
+fn shape_value(g: &[f64], (p, f): (usize, f64)) -> f64 {
     g[p] * (1.0 - f) + g[p + 1] * f
 }
 
@@ -609,32 +616,67 @@ fn shape_place(mu0: f64, mu: f64, (i, t): (usize, f64)) -> (usize, f64) {
     (base + s, x - s as f64)
 }
 
+/// The integrals over `mu` of `2 pi mu g(mu)` (`g` a crossing shape,
+/// [`shape_at`]) that the table's interpolants in `mu_o` need: `below`, on
+/// `[0, mu_0]` (where the table is constant), and per node interval `c` the
+/// cumulative moments `cells[c][p] = int_0^{p / SHAPE_STEPS} (1, t) 2 pi mu
+/// g(mu) dmu` in the interval's fraction `t`. Two-point Gauss-Legendre on
+/// every step of `g`'s table, where the integrand times a linear function
+/// of `t` is a cubic: exact.
+struct ShapeMoments {
+    below: f64,
+    cells: Vec<Vec<(f64, f64)>>,
+}
+
+fn shape_moments(mu: &[f64], g: &[f64]) -> ShapeMoments {
+    let n = mu.len();
+    let k = SHAPE_STEPS;
+    let gl = [0.5 - 0.5 / 3f64.sqrt(), 0.5 + 0.5 / 3f64.sqrt()];
+    let mut below = 0.0;
+    let h0 = mu[0] / k as f64;
+    for s in 0..k {
+        for x in gl {
+            let m = (s as f64 + x) * h0;
+            below += 0.5 * h0 * 2.0 * PI * m * shape_at(g, mu[0], m, (0, 0.0));
+        }
+    }
+    let cells = (0..n - 1)
+        .map(|c| {
+            let h = mu[c + 1] - mu[c];
+            let mut acc = vec![(0.0, 0.0); k + 1];
+            for s in 0..k {
+                let (mut m0, mut m1) = acc[s];
+                for x in gl {
+                    let t = (s as f64 + x) / k as f64;
+                    let m = mu[c] + t * h;
+                    let v = 0.5 / k as f64 * h * 2.0 * PI * m * shape_at(g, mu[0], m, (c, t));
+                    m0 += v;
+                    m1 += v * t;
+                }
+                acc[s + 1] = (m0, m1);
+            }
+            acc
+        })
+        .collect();
+    ShapeMoments { below, cells }
+}
+
 /// `2 pi int_0^1 hat_o(mu) g(mu) mu dmu` for each node `o`: the exact
 /// integral over outgoing directions of the table's interpolation in `mu_o`
 /// (linear between the nodes, constant below the smallest, [`locate`]) times
 /// the exit face's crossing shape `g` ([`shape_at`]), per unit coefficient of
-/// order 0. Two-point Gauss-Legendre on every step of `g`'s table, where the
-/// integrand is a cubic: exact.
+/// order 0, from [`shape_moments`]: node `o` takes `1 - t` of interval `o`
+/// and `t` of interval `o - 1`.
 fn interpolant_weights(mu: &[f64], g: &[f64]) -> Vec<f64> {
-    let n = mu.len();
-    let k = SHAPE_STEPS;
-    let mut w = vec![0.0; n];
-    let gl = [0.5 - 0.5 / 3f64.sqrt(), 0.5 + 0.5 / 3f64.sqrt()];
-    let mut edges = vec![0.0];
-    edges.extend_from_slice(mu);
-    for e in edges.windows(2) {
-        let h = (e[1] - e[0]) / k as f64;
-        for s in 0..k {
-            for x in gl {
-                let m = e[0] + (s as f64 + x) * h;
-                let at = locate(mu, m);
-                let v = 0.5 * h * shape_at(g, mu[0], m, at) * m;
-                w[at.0] += v * (1.0 - at.1);
-                w[at.0 + 1] += v * at.1;
-            }
-        }
+    let ShapeMoments { below, cells } = shape_moments(mu, g);
+    let mut w = vec![0.0; mu.len()];
+    w[0] = below;
+    for (c, m) in cells.iter().enumerate() {
+        let (m0, m1) = m[SHAPE_STEPS];
+        w[c] += m0 - m1;
+        w[c + 1] += m1;
     }
-    w.iter().map(|x| 2.0 * PI * x).collect()
+    w
 }
 
 /// Scales the tables so that their interpolant conserves what the
@@ -771,48 +813,11 @@ fn triangle_weights(to: f64, tj: f64) -> ([(usize, usize); 3], [f64; 3]) {
 /// at `to = tj`, a point of the shapes' steps, and two-point Gauss-Legendre
 /// on every step is exact for them times `2 pi mu g(mu)`. Channel `ch` of
 /// the table, with that channel's shapes.
-fn ridge_ratios(
-    table: &[[Vec<Rgb>; 2]; 2],
-    mu: &[f64],
-    shape: &[Vec<f64>; 2],
-    orders: usize,
-    ch: usize,
-) -> [Vec<f64>; 2] {
+fn ridge_ratios(table: &[[Vec<Rgb>; 2]; 2], mu: &[f64], shape: [&[f64]; 2], orders: usize, ch: usize) -> [Vec<f64>; 2] {
     let n = mu.len();
     let k = SHAPE_STEPS;
-    let gl = [0.5 - 0.5 / 3f64.sqrt(), 0.5 + 0.5 / 3f64.sqrt()];
-    // Per exit side: the integral of 2 pi mu g below the smallest node, and
-    // per cell the cumulative moments int_0^{p/k} (1, t) 2 pi mu g h dt.
-    let moments = |g: &[f64]| {
-        let mut below = 0.0;
-        let h0 = mu[0] / k as f64;
-        for s in 0..k {
-            for x in gl {
-                let m = (s as f64 + x) * h0;
-                below += 0.5 * h0 * 2.0 * PI * m * shape_at(g, mu[0], m, (0, 0.0));
-            }
-        }
-        let cells: Vec<Vec<(f64, f64)>> = (0..n - 1)
-            .map(|c| {
-                let h = mu[c + 1] - mu[c];
-                let mut acc = vec![(0.0, 0.0); k + 1];
-                for s in 0..k {
-                    let (mut m0, mut m1) = acc[s];
-                    for x in gl {
-                        let t = (s as f64 + x) / k as f64;
-                        let m = mu[c] + t * h;
-                        let v = 0.5 / k as f64 * h * 2.0 * PI * m * shape_at(g, mu[0], m, (c, t));
-                        m0 += v;
-                        m1 += v * t;
-                    }
-                    acc[s + 1] = (m0, m1);
-                }
-                acc
-            })
-            .collect();
-        (below, cells)
-    };
-    let mom = [moments(&shape[0]), moments(&shape[1])];
+    // Per exit side, the integrals of the rows' pieces.
+    let mom = shape.map(|g| shape_moments(mu, g));
     [0usize, 1].map(|side| {
         let mut ratio = vec![1.0; shape[side].len()];
         for j in 0..n - 1 {
@@ -821,7 +826,7 @@ fn ridge_ratios(
                 let (mut tri, mut bil) = (0.0, 0.0);
                 for (tr, tab) in table[side].iter().enumerate() {
                     let exit = if tr == 1 { 1 - side } else { side };
-                    let (below, cells) = &mom[exit];
+                    let ShapeMoments { below, cells } = &mom[exit];
                     let c = |o: usize, jj: usize| tab[(o * n + jj) * orders].0[ch];
                     let flat = below * ((1.0 - t) * c(0, j) + t * c(0, j + 1));
                     tri += flat;
@@ -1216,8 +1221,7 @@ impl SlabBsdf {
         // the balance: the solution rebalanced, a few passes.
         for _ in 0..RIDGE_PASSES {
             for c in 0..3 {
-                let now = [shape[0][c].clone(), shape[1][c].clone()];
-                let ratio = ridge_ratios(&table, &g.mu, &now, m_count, c);
+                let ratio = ridge_ratios(&table, &g.mu, [&shape[0][c], &shape[1][c]], m_count, c);
                 for ((g_side, g_lin), r) in shape.iter_mut().zip(&linear_shape).zip(&ratio) {
                     for ((x, x_lin), f) in g_side[c].iter_mut().zip(g_lin).zip(r) {
                         *x = x_lin * f;
@@ -1382,12 +1386,11 @@ impl SlabBsdf {
             }
         };
         let exit = if transmit { 1 - side } else { side };
-        let (pi, fi) = shape_place(self.mu[0], wi.mu, wi.at);
-        let (po, fo) = shape_place(self.mu[0], wo.mu, wo.at);
-        let g = |c: usize| {
-            let (gi, go) = (&self.shape[side][c], &self.shape[exit][c]);
-            (gi[pi] * (1.0 - fi) + gi[pi + 1] * fi) * (go[po] * (1.0 - fo) + go[po + 1] * fo)
-        };
+        let (at_i, at_o) = (
+            shape_place(self.mu[0], wi.mu, wi.at),
+            shape_place(self.mu[0], wo.mu, wo.at),
+        );
+        let g = |c: usize| shape_value(&self.shape[side][c], at_i) * shape_value(&self.shape[exit][c], at_o);
         if tab.channels == 1 {
             acc * g(0)
         } else {
@@ -1747,7 +1750,7 @@ mod tests {
                 }
             }
         }
-        let ratios = ridge_ratios(&table, &mu, &shape, orders, 1);
+        let ratios = ridge_ratios(&table, &mu, [&shape[0], &shape[1]], orders, 1);
         for side in 0..2 {
             for j in 0..n - 1 {
                 for p in [1, 7, k / 2, k - 1] {

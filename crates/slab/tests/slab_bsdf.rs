@@ -231,9 +231,10 @@ fn energy_is_bounded() {
 
 /// `int eval(wi, wo) |cos wo| dwo` over both hemispheres by a deterministic
 /// rule: in `mu_o` Gauss-Legendre (`per` points) on each interval between the
-/// table's nodes and `mu_i` (the table is linear in `mu_o` there: its
-/// triangles' diagonal crosses the interval holding `mu_i` at `mu_o = mu_i`,
-/// so the rule is exact for it) and on `[0, mu_0]`, each interval also split
+/// table's nodes and `mu_i` (the table's triangles are linear in `mu_o`
+/// there: their diagonal crosses the interval holding `mu_i` at `mu_o =
+/// mu_i`; times the crossing shapes, linear on finer steps, the rule is
+/// nearly exact) and on `[0, mu_0]`, each interval also split
 /// in `split` equal parts (for the analytic face's lobe); in azimuth the
 /// midpoint rule with `n_phi` points, exact for the table's Fourier sum when
 /// `n_phi` exceeds twice the orders.
@@ -293,9 +294,8 @@ fn grid_albedo(f: impl Fn(DVec3) -> f64, nodes: &[f64], mu_i: f64, per: usize, s
 /// the ridge ratios bend the shapes within the intervals).
 /// The interpolation's triangles alone, without the ridge ratios that
 /// restore the albedo between the nodes of `mu_i`, were 6.1e-4 off (the
-/// first sheet at 15 degrees; 3e-7
-/// with bilinear weights, which are 3.7% low on a thin sheet's transmission
-/// peak between the nodes). The analytic lobe (component `surface`) is
+/// first sheet at 15 degrees; 3e-7 with bilinear weights, which are 3.7%
+/// low on a thin sheet's transmission peak between the nodes). The analytic lobe (component `surface`) is
 /// integrated by the same rule over `wo`, finer ([`SURFACE_SPLIT`],
 /// [`SURFACE_PHI`]: doubling both moves no sum by 1e-7), which checks
 /// `face_reflectance` independently (within 1e-4; measured 1.6e-5), and
