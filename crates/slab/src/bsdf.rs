@@ -49,7 +49,8 @@
 //! values. Bilinear weights, used until 2026-12-05, average a ridge with
 //! its flanks between the nodes: a thin sheet's unscattered transmission
 //! peak (thin tissue at 30 degrees) scalloped by 3.7% between nodes, and
-//! doubling the nodes moved it by 2.9% (now 0.1%). The split is the same
+//! doubling the nodes moved it by 2.9% (now 0.15%,
+//! examples/convergence_causes.rs). The split is the same
 //! for a cell and its transpose, so the interpolated table keeps the
 //! solution's reciprocity exactly; the weights are non-negative (no
 //! overshoot), and at a node of either cosine they are linear in the other
@@ -66,9 +67,10 @@
 //! order 0 stays the triangles'). Linear weights in `mu` let every order
 //! fall like `theta^2`, which halved order 1 there (a thin sheet's
 //! transmission 2.5 degrees from the normal: 8% off, of opposite signs
-//! either side; now 2.5% against twice the nodes), and the triangles took
+//! either side; now 0.8% against twice the nodes), and the triangles took
 //! the orders `m >= 1` of light arriving near the normal from one node of
-//! `mu_o` (7% off at 10 degrees, now 3.6%). The Fourier sum can ring below
+//! `mu_o` (6.9% from twice the nodes at 10 degrees, now 3.6%;
+//! examples/convergence.rs). The Fourier sum can ring below
 //! zero for lobes narrower than the orders resolve: `eval` returns `max(f,
 //! 0)` per channel.
 //!

@@ -60,7 +60,7 @@
 //! moves by up to 1.4% in its flanks (linear interpolation in `mu` across
 //! their bend) and by 3.6% when lit within the last interval of nodes
 //! (4.85 degrees from the normal; its peak, interpolated along the table's
-//! diagonal since 2026-12-05, by 0.1%); further analytic parts
+//! diagonal since 2026-12-05, by 0.15%); further analytic parts
 //! (unscattered transmission through rough faces, exact single scattering
 //! as its own term: the tables hold every scattering order, so `slab` has
 //! no separate `single` component). The projected faces' R/T split (1e-3

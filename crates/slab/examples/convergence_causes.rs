@@ -1,0 +1,82 @@
+//! Where the remaining node changes of examples/convergence.rs come from
+//! (README, "Convergence"): the same in-plane `eval` on 32, 64 and 128
+//! nodes (16, 32, 64 in the cone of total reflection) at the points that
+//! move most, and beside them the checks that tell the causes apart:
+//! - the coated sheets with a front smoother than the grid (glossy, devB)
+//!   at and near normal incidence, and the same sheets uncoated (the base's
+//!   index set to the coating's);
+//! - thin tissue lit at 30 degrees, seen at the two nodes around 10 degrees
+//!   (8.87 and 12.85 with 32 nodes) and at 10 degrees between them, around
+//!   its straight-through peak, and 2.5 degrees either side of the normal;
+//! - thin tissue lit at 2.5 degrees (inside the last interval of nodes),
+//!   seen from -20 to 20 degrees.
+//!
+//! `cargo run --release -p paperbsdf-slab --example convergence_causes`
+
+use paperbsdf_core::geometry::in_plane_directions;
+use paperbsdf_core::{Bsdf, PaperParams};
+use paperbsdf_slab::{SlabBsdf, SlabOptions};
+
+// The cases of docs/accuracy.md, as the accuracy example has them.
+#[path = "../../sim/examples/support/cases.rs"]
+mod cases;
+
+/// `eval` (mean over channels) on 32, 64 and 128 nodes at `(theta_i, theta_o, transmit)`.
+fn row(p: &PaperParams, points: &[(f64, f64, bool)]) {
+    let base = SlabOptions::default();
+    let bsdfs: Vec<SlabBsdf> = [1, 2, 4]
+        .iter()
+        .map(|&k| {
+            let o = SlabOptions {
+                nodes: k * base.nodes,
+                tir_nodes: k * base.tir_nodes,
+                ..base
+            };
+            SlabBsdf::with_options(p, &o).expect("build")
+        })
+        .collect();
+    for &(ti, to, tr) in points {
+        let (wi, wo) = in_plane_directions(ti, to, tr);
+        let v: Vec<f64> = bsdfs.iter().map(|b| b.eval(wi, wo).mean()).collect();
+        println!(
+            "  ({ti:.2} {} {to:.2}): 32 {:.5}  64 {:.5}  128 {:.5}   32/64 {:+.2}%  64/128 {:+.2}%",
+            if tr { "T" } else { "R" },
+            v[0],
+            v[1],
+            v[2],
+            100.0 * (v[0] / v[1] - 1.0),
+            100.0 * (v[1] / v[2] - 1.0)
+        );
+    }
+}
+
+fn main() {
+    let cases = cases::cases();
+    let get = |n: &str| cases.iter().find(|c| c.0 == n).expect("case").1.clone();
+    for name in ["preset-glossy", "devB"] {
+        let p = get(name);
+        let pts = [(0.0, 0.0, false), (2.5, 2.5, false)];
+        println!("{name}, coated (eta_f {} over eta_b {}):", p.eta_f, p.eta_b);
+        row(&p, &pts);
+        println!("{name}, uncoated (eta_b = eta_f):");
+        row(&PaperParams { eta_b: p.eta_f, ..p }, &pts);
+    }
+    let t = get("thin-tissue");
+    let nodes = SlabBsdf::new(&t).expect("build").nodes().to_vec();
+    let n = nodes.len();
+    let (a, b) = (nodes[n - 3].acos().to_degrees(), nodes[n - 4].acos().to_degrees());
+    println!("thin-tissue lit at 30, seen at the nodes {a:.2} and {b:.2} and between them:");
+    row(&t, &[(30.0, a, true), (30.0, 10.0, true), (30.0, b, true)]);
+    println!("thin-tissue lit at 30, seen around the straight-through peak (-30) and near the normal:");
+    let pts: Vec<(f64, f64, bool)> = [-34.0, -32.0, -30.0, -28.0, -26.0, -2.5, 2.5]
+        .iter()
+        .map(|&to| (30.0, to, true))
+        .collect();
+    row(&t, &pts);
+    println!(
+        "thin-tissue lit at 2.5 (the last interval of nodes ends at {:.2}):",
+        nodes[n - 2].acos().to_degrees()
+    );
+    let pts: Vec<(f64, f64, bool)> = (-8..=8).map(|k| (2.5, 2.5 * k as f64, true)).collect();
+    row(&t, &pts);
+}
