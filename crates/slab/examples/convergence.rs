@@ -6,7 +6,7 @@
 //! transmission, light on the front), and the
 //! directional albedo, for the default options against doubled nodes
 //! (64 outside, 32 in the cone of total reflection) and against doubled
-//! Fourier orders (96), for every case of docs/accuracy.md (the presets,
+//! Fourier orders (96, and 256 for the lit face's walk), for every case of docs/accuracy.md (the presets,
 //! devA, devB and the spread of sheets), in both face modes.
 //!
 //! Printed per sheet: the largest relative change of a value (with the
@@ -70,6 +70,7 @@ fn main() {
             "orders x2",
             SlabOptions {
                 orders: 2 * base.orders,
+                walk_orders: 2 * base.walk_orders,
                 ..base
             },
         ),

@@ -134,6 +134,7 @@
 //! scattering included (`slab` does not split orders 1 and 2+).
 
 use crate::error::SlabError;
+use crate::interface::walk_window;
 use crate::slab::{Discretisation, SlabSpec, Solution};
 use nalgebra::DMatrix;
 use paperbsdf_core::bsdf::{Bsdf, BsdfFlags, BsdfSample};
@@ -150,8 +151,9 @@ use std::f64::consts::PI;
 /// (module doc): keeps the density positive where the table's cells are empty.
 pub const COSINE_SHARE: f64 = 0.1;
 
-/// Most Fourier orders a [`SlabBsdf`] evaluates (the size of `eval`'s cosine buffer).
-pub const MAX_ORDERS: usize = 128;
+/// Most Fourier orders a [`SlabBsdf`] solves or evaluates ([`SlabOptions::orders`],
+/// [`SlabOptions::walk_orders`]).
+pub const MAX_ORDERS: usize = 512;
 
 /// How finely a [`SlabBsdf`] is solved and tabulated.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -166,6 +168,16 @@ pub struct SlabOptions {
     /// degrees: RMS log error against the simulator 0.022 with 32 orders,
     /// 0.016 with 48, 0.012 with 64; build 0.48 / 0.63 / 0.9 s).
     pub orders: usize,
+    /// Fourier orders of the light the lit face's microsurface reflects
+    /// more than once (`face_scattering = "multiple"`), `orders` to
+    /// [`MAX_ORDERS`]; default 128. At grazing incidence on a smooth face
+    /// this light is a forward peak narrower in azimuth than `orders`
+    /// resolve (luster's Beckmann 0.15 front at 75 degrees, seen at 80:
+    /// 6% under its converged value with 48 orders, Fejer-summed); it
+    /// reaches the sheet's reflection unchanged by the layers below, so it
+    /// alone is summed to more orders ([`crate::interface`], module doc
+    /// "Multiple scattering on the microsurface").
+    pub walk_orders: usize,
     /// Bins in `|phi|` of the sampling density, 1 to 1024.
     pub phi_bins: usize,
     /// Bins in `mu` (per hemisphere) of the sampling density, 1 to 1024.
@@ -178,6 +190,7 @@ impl Default for SlabOptions {
             nodes: 32,
             tir_nodes: 16,
             orders: 48,
+            walk_orders: 128,
             phi_bins: 32,
             mu_bins: 32,
         }
@@ -246,14 +259,18 @@ impl SmoothSheet {
 /// the number of orders that matter for each node pair.
 #[derive(Clone, Debug, Default)]
 struct Tables {
-    /// Channel `k` of `c_m[o][j]` at `((o n + j) M + m) K + k`, with `K` =
-    /// [`Tables::channels`].
+    /// Channel `k` of `c_m[o][j]` at `(start[p] + m) K + k`, `p = o n + j`,
+    /// `m < len[p]`, with `K` = [`Tables::channels`]: each pair stores only
+    /// the orders it keeps (the walk's reflection at grazing incidence
+    /// needs up to [`SlabOptions::walk_orders`], most pairs a few).
     c: [[Vec<f64>; 2]; 2],
-    /// Per `(o n + j)`: the orders `0..len` kept, the fewest whose dropped
-    /// tail sums to at most [`ORDER_CUTOFF`] of the pair's largest
+    /// Per pair `p = o n + j`: the orders `0..len` kept, the fewest whose
+    /// dropped tail sums to at most [`ORDER_CUTOFF`] of the pair's largest
     /// coefficient (the same for a pair and its reciprocal, so truncation
     /// keeps reciprocity exact).
     len: [[Vec<u16>; 2]; 2],
+    /// Per pair: where its orders start in `c`, in orders (`c` index / `K`).
+    start: [[Vec<u32>; 2]; 2],
     /// Channels stored: 1 for a grey sheet (every colour channel has the
     /// same medium, so one solve and equal tables: `eval` sums one series
     /// instead of three), else 3.
@@ -319,26 +336,28 @@ impl Tables {
                 sym[1][1][j * n + o] = tf;
             }
         }
-        // Orders past a pair's length are zero, so that `eval_table` can sum
-        // its three corners over the longest of their lengths.
-        for s in 0..2 {
-            for t in 0..2 {
+        let channels = if grey { 1 } else { 3 };
+        let mut start: [[Vec<u32>; 2]; 2] = Default::default();
+        let c = std::array::from_fn(|s| {
+            std::array::from_fn(|t| {
+                let mut packed = Vec::new();
+                let mut at = 0u32;
                 for (p, &l) in sym[s][t].iter().enumerate() {
-                    for v in &mut c[s][t][p * orders + l as usize..(p + 1) * orders] {
-                        *v = Rgb::ZERO;
+                    start[s][t].push(at);
+                    at += u32::from(l);
+                    for v in &c[s][t][p * orders..p * orders + l as usize] {
+                        packed.extend(v.0.into_iter().take(channels));
                     }
                 }
-            }
-        }
-        let channels = if grey { 1 } else { 3 };
-        let c = c.map(|side| {
-            side.map(|tab| {
-                tab.iter()
-                    .flat_map(|v| v.0.into_iter().take(channels))
-                    .collect::<Vec<f64>>()
+                packed
             })
         });
-        Tables { c, len: sym, channels }
+        Tables {
+            c,
+            len: sym,
+            start,
+            channels,
+        }
     }
 }
 
@@ -403,9 +422,7 @@ pub struct SlabBsdf {
     paper: PaperBsdf,
     /// Outside nodes, ascending, `mu[n - 1] = 1`.
     mu: Vec<f64>,
-    /// Fourier orders.
-    orders: usize,
-    /// `[side of incidence][transmit]`: coefficients `c_m[o][j]` at `(o n + j) M + m`.
+    /// `[side of incidence][transmit]`: the Fourier coefficients `c_m[o][j]` ([`Tables`]).
     table: Tables,
     /// The same for the unscattered part of the table (component `direct`).
     direct: Tables,
@@ -893,33 +910,66 @@ fn cos_phi(wi: DVec3, wo: DVec3) -> f64 {
     c.clamp(-1.0, 1.0)
 }
 
-/// The Fourier series `sum_m s_m cos(m phi)` (`c = cos phi`) of the three
-/// node pairs `pairs` of a table `t` with `K` channels and `mcount` orders
-/// per pair, weighted by `weights`, over orders `0..len`: per order the
-/// corners are weighted first (`s_m`), then the series is summed with
-/// `cos(m phi)` by the Chebyshev recurrence.
-#[inline(always)]
-fn fourier_sum<const K: usize>(
-    t: &[f64],
-    pairs: [usize; 3],
-    weights: [f64; 3],
-    mcount: usize,
-    len: usize,
-    c: f64,
-) -> [f64; K] {
-    let [r0, r1, r2] = pairs.map(|p| &t[p * mcount * K..(p * mcount + len) * K]);
-    let [w0, w1, w2] = weights;
-    let (mut c_prev, mut c_m) = (c, 1.0);
-    let mut acc = [0.0f64; K];
-    let rows = r0.chunks_exact(K).zip(r1.chunks_exact(K)).zip(r2.chunks_exact(K));
-    for ((a, b), d) in rows {
-        for k in 0..K {
-            let s = a[k] * w0 + b[k] * w1 + d[k] * w2;
-            acc[k] += s * c_m;
+/// Whether a node pair's series `sum_m v_m cos(m phi)` (per channel; `v` its
+/// orders) rings below zero by more than [`RING_TOLERANCE`] of its mean:
+/// the mean of its negative part over `4 M` midpoints in `[0, pi]`, where
+/// `eval` would clamp it and so add that much energy. Only where the orders
+/// `m >= 1` could outweigh order 0.
+fn rings_below_zero(v: &[Rgb]) -> bool {
+    (0..3).any(|k| {
+        let c0 = v[0].0[k];
+        let tail: f64 = v[1..].iter().map(|x| x.0[k].abs()).sum();
+        if tail <= c0 {
+            return false;
         }
-        let next = 2.0 * c * c_m - c_prev;
-        c_prev = c_m;
-        c_m = next;
+        let points = 4 * v.len();
+        let negative: f64 = (0..points)
+            .map(|i| {
+                let c = (PI * (i as f64 + 0.5) / points as f64).cos();
+                let (mut prev, mut cur, mut f) = (c, 1.0, 0.0);
+                for x in v {
+                    f += x.0[k] * cur;
+                    let next = 2.0 * c * cur - prev;
+                    prev = cur;
+                    cur = next;
+                }
+                (-f).max(0.0)
+            })
+            .sum::<f64>()
+            / points as f64;
+        negative > RING_TOLERANCE * c0.abs().max(TINY)
+    })
+}
+
+/// How much of a node pair's mean the walk's window may ring below zero
+/// ([`rings_below_zero`]): the energy `eval`'s clamping adds, well below
+/// the 2e-5 the interpolated tables are balanced to.
+const RING_TOLERANCE: f64 = 1e-5;
+
+/// The Fourier series `sum_m s_m cos(m phi)` (`c = cos phi`) of the three
+/// node pairs `pairs` of a table `tab` with `K` channels, weighted by
+/// `weights`: each pair over the orders it keeps, summed with `cos(m phi)`
+/// by the Chebyshev recurrence.
+#[inline(always)]
+fn fourier_sum<const K: usize>(tab: &Tables, st: usize, pairs: [usize; 3], weights: [f64; 3], c: f64) -> [f64; K] {
+    let t = &tab.c[st >> 1][st & 1];
+    let (start, len) = (&tab.start[st >> 1][st & 1], &tab.len[st >> 1][st & 1]);
+    let mut acc = [0.0f64; K];
+    for (&p, &w) in pairs.iter().zip(&weights) {
+        if w == 0.0 {
+            continue;
+        }
+        let from = start[p] as usize * K;
+        let row = &t[from..from + len[p] as usize * K];
+        let (mut c_prev, mut c_m) = (w * c, w);
+        for a in row.chunks_exact(K) {
+            for k in 0..K {
+                acc[k] += a[k] * c_m;
+            }
+            let next = 2.0 * c * c_m - c_prev;
+            c_prev = c_m;
+            c_m = next;
+        }
     }
     acc
 }
@@ -928,37 +978,38 @@ fn fourier_sum<const K: usize>(
 /// three node pairs `pairs` and `weights` (as [`fourier_sum`]), the orders
 /// `m >= 1` from the two node pairs of `pole` with their weights, summed with
 /// `r^m cos(m phi)` by the recurrence `a_{m+1} = 2 r c a_m - r^2 a_{m-1}`.
-#[allow(clippy::too_many_arguments)]
 fn fourier_sum_pole<const K: usize>(
-    t: &[f64],
+    tab: &Tables,
+    st: usize,
     pairs: [usize; 3],
     weights: [f64; 3],
     pole: &PoleCorners,
-    mcount: usize,
-    len: usize,
     c: f64,
 ) -> [f64; K] {
+    let t = &tab.c[st >> 1][st & 1];
+    let (start, len) = (&tab.start[st >> 1][st & 1], &tab.len[st >> 1][st & 1]);
     let mut acc = [0.0f64; K];
-    for (p, w) in pairs.iter().zip(&weights) {
+    for (&p, &w) in pairs.iter().zip(&weights) {
         for (k, a) in acc.iter_mut().enumerate() {
-            *a += w * t[p * mcount * K + k];
+            *a += w * t[start[p] as usize * K + k];
         }
     }
     let (rc, r2) = (pole.r * c, pole.r * pole.r);
-    let (mut a_prev, mut a_m) = (1.0, rc);
-    for m in 1..len {
-        for (k, a) in acc.iter_mut().enumerate() {
-            let s: f64 = pole
-                .pairs
-                .iter()
-                .zip(&pole.weights)
-                .map(|(p, w)| w * t[(p * mcount + m) * K + k])
-                .sum();
-            *a += s * a_m;
+    for (&p, &w) in pole.pairs.iter().zip(&pole.weights) {
+        if w == 0.0 {
+            continue;
         }
-        let next = 2.0 * rc * a_m - r2 * a_prev;
-        a_prev = a_m;
-        a_m = next;
+        let from = start[p] as usize * K;
+        let row = &t[from..from + len[p] as usize * K];
+        let (mut a_prev, mut a_m) = (w, w * rc);
+        for a in row.chunks_exact(K).skip(1) {
+            for (k, x) in acc.iter_mut().enumerate() {
+                *x += a[k] * a_m;
+            }
+            let next = 2.0 * rc * a_m - r2 * a_prev;
+            a_prev = a_m;
+            a_m = next;
+        }
     }
     acc
 }
@@ -1031,7 +1082,14 @@ impl SlabBsdf {
             return Err(SlabError::Discretisation {
                 name: "orders",
                 value: opts.orders as f64,
-                range: "[1, 128]",
+                range: "[1, 512]",
+            });
+        }
+        if opts.walk_orders < opts.orders || opts.walk_orders > MAX_ORDERS {
+            return Err(SlabError::Discretisation {
+                name: "walk_orders",
+                value: opts.walk_orders as f64,
+                range: "[orders, 512]",
             });
         }
         for (name, v) in [("phi_bins", opts.phi_bins), ("mu_bins", opts.mu_bins)] {
@@ -1059,6 +1117,7 @@ impl SlabBsdf {
             nodes: opts.nodes,
             tir_nodes: opts.tir_nodes,
             orders: opts.orders,
+            walk_orders: opts.walk_orders,
             ..Discretisation::default()
         };
         let prepared = specs[0].prepare(&disc)?;
@@ -1081,7 +1140,22 @@ impl SlabBsdf {
         }
         let g = &prepared.outside;
         let n = g.len();
-        let m_count = opts.orders;
+        // The table's orders: the solution's, and the walk's reflection from
+        // outside to more (`SlabOptions::walk_orders`) when a face has it.
+        let m_solved = opts.orders;
+        // The weights the solution's orders carry the walk with (crate::interface).
+        let fejer = |m: usize| {
+            if m < m_solved {
+                1.0 - m as f64 / m_solved as f64
+            } else {
+                0.0
+            }
+        };
+        let m_count = prepared
+            .faces
+            .iter()
+            .map(|f| f.walk_r_top.len())
+            .fold(m_solved, usize::max);
         // The faces' first reflection from outside, per order: the front
         // face's r_top, the back face's (used flipped) r_top. A smooth
         // coated front reflects a delta lobe that includes the light its
@@ -1178,18 +1252,25 @@ impl SlabBsdf {
                 let mut dir = vec![Rgb::ZERO; n * n * m_count];
                 for (c, &k) in solution_of.iter().enumerate() {
                     let (full, unsc) = &solutions[k];
+                    // The lit face's walk reflection beyond Fejer's sum (module doc).
+                    let walk_r = &prepared.faces[side].walk_r_top;
                     for m in 0..m_count {
                         let eps = if m == 0 { 1.0 } else { 2.0 };
-                        let (kf, ku) = (block(full, side, transmit, m), block(unsc, side, transmit, m));
+                        let solved =
+                            (m < m_solved).then(|| (block(full, side, transmit, m), block(unsc, side, transmit, m)));
+                        let walk = walk_r.get(m).filter(|_| !transmit);
                         for o in 0..n {
                             for j in 0..n {
                                 let exit = if transmit { 1 - side } else { side };
                                 let scale = eps / (2.0 * PI * g.w[j] * g.mu[j]) * cross[side][j] * cross[exit][o];
-                                let surface = if transmit { 0.0 } else { face_r(side, m)[(o, j)] };
-                                let (vt, vd) = if both_smooth {
-                                    (kf[(o, j)] - ku[(o, j)], 0.0)
-                                } else {
-                                    (kf[(o, j)] - surface, ku[(o, j)] - surface)
+                                let gain = walk.map_or(0.0, |w| w[(o, j)] * (walk_window(m, m_count) - fejer(m)));
+                                let (vt, vd) = match solved {
+                                    None => (gain, gain),
+                                    Some((kf, ku)) if both_smooth => (kf[(o, j)] - ku[(o, j)], 0.0),
+                                    Some((kf, ku)) => {
+                                        let surface = if transmit { 0.0 } else { face_r(side, m)[(o, j)] };
+                                        (kf[(o, j)] - surface + gain, ku[(o, j)] - surface + gain)
+                                    }
                                 };
                                 // At normal incidence or exit (the node mu = 1)
                                 // nothing depends on azimuth: orders m >= 1
@@ -1208,6 +1289,38 @@ impl SlabBsdf {
                 }
                 table[side][t] = tab;
                 direct[side][t] = dir;
+            }
+            // Node pairs whose reflection with the walk summed to its orders
+            // goes below zero anywhere in azimuth (the walk's peak narrower
+            // than even those orders resolve: GGX 0.1 at 85 degrees) take
+            // Fejer's weights to its orders instead, which keep it
+            // non-negative (module doc, "Orders").
+            let walk_r = &prepared.faces[side].walk_r_top;
+            if walk_r.len() > m_solved {
+                let rings = |o: usize, j: usize| -> bool {
+                    [&table[side][0], &direct[side][0]]
+                        .iter()
+                        .any(|tab| rings_below_zero(&tab[(o * n + j) * m_count..(o * n + j + 1) * m_count]))
+                };
+                let fallback: Vec<(usize, usize)> = (0..n * n)
+                    .into_par_iter()
+                    .filter_map(|p| {
+                        let (o, j) = (p / n, p % n);
+                        (o <= j && (rings(o, j) || rings(j, o))).then_some((o, j))
+                    })
+                    .collect();
+                for (a, b) in fallback {
+                    for (o, j) in [(a, b), (b, a)] {
+                        let scale = 2.0 / (2.0 * PI * g.w[j] * g.mu[j]) * cross[side][j] * cross[side][o];
+                        for (m, w) in walk_r.iter().enumerate().skip(1) {
+                            let d = w[(o, j)] * ((1.0 - m as f64 / m_count as f64) - walk_window(m, m_count)) * scale;
+                            let idx = (o * n + j) * m_count + m;
+                            for tab in [&mut table[side][0], &mut direct[side][0]] {
+                                tab[idx] += Rgb::splat(d);
+                            }
+                        }
+                    }
+                }
             }
         }
         // The crossing shapes of the faces (module doc, "Energy"): the light
@@ -1254,7 +1367,6 @@ impl SlabBsdf {
         let mut me = SlabBsdf {
             paper,
             mu: g.mu.clone(),
-            orders: m_count,
             table,
             direct,
             smooth,
@@ -1357,35 +1469,20 @@ impl SlabBsdf {
     fn eval_table_at(&self, tab: &Tables, wi: Place, wo: Place, c: f64) -> Rgb {
         let side = usize::from(wi.z < 0.0);
         let transmit = wi.z * wo.z < 0.0;
-        let t = &tab.c[side][transmit as usize];
-        let lens = &tab.len[side][transmit as usize];
+        let st = 2 * side + transmit as usize;
         let n = self.mu.len();
-        let mcount = self.orders;
         let ((j, tj), (o, to)) = (wi.at, wo.at);
         let (corners, weights) = triangle_weights(to, tj);
         let pairs = corners.map(|(a, b)| (o + a) * n + j + b);
-        let mut len = 0usize;
-        for (p, w) in pairs.iter().zip(&weights) {
-            if *w != 0.0 {
-                len = len.max(lens[*p] as usize);
-            }
-        }
         let acc = match pole_corners(&self.mu, wi, wo) {
             None => match tab.channels {
-                1 => Rgb::splat(fourier_sum::<1>(t, pairs, weights, mcount, len, c)[0]),
-                _ => Rgb(fourier_sum::<3>(t, pairs, weights, mcount, len, c)),
+                1 => Rgb::splat(fourier_sum::<1>(tab, st, pairs, weights, c)[0]),
+                _ => Rgb(fourier_sum::<3>(tab, st, pairs, weights, c)),
             },
-            Some(pole) => {
-                for (p, w) in pole.pairs.iter().zip(&pole.weights) {
-                    if *w != 0.0 {
-                        len = len.max(lens[*p] as usize);
-                    }
-                }
-                match tab.channels {
-                    1 => Rgb::splat(fourier_sum_pole::<1>(t, pairs, weights, &pole, mcount, len, c)[0]),
-                    _ => Rgb(fourier_sum_pole::<3>(t, pairs, weights, &pole, mcount, len, c)),
-                }
-            }
+            Some(pole) => match tab.channels {
+                1 => Rgb::splat(fourier_sum_pole::<1>(tab, st, pairs, weights, &pole, c)[0]),
+                _ => Rgb(fourier_sum_pole::<3>(tab, st, pairs, weights, &pole, c)),
+            },
         };
         let exit = if transmit { 1 - side } else { side };
         let (at_i, at_o) = (
@@ -1445,6 +1542,7 @@ impl SlabBsdf {
                     .map(|v| v.len() * std::mem::size_of::<f64>())
                     .sum::<usize>()
                     + t.len.iter().flatten().map(|v| v.len() * 2).sum::<usize>()
+                    + t.start.iter().flatten().map(|v| v.len() * 4).sum::<usize>()
             })
             .sum();
         let cells: usize = self

@@ -284,6 +284,57 @@ pub fn multiple_scattering(
     })
 }
 
+/// The walk's reflection from outside (`r_top`, orders >= 2) for orders
+/// `0..orders`, from the chain restricted to the outside states: the light
+/// that refracts into the face's dielectric on the way is left out. For the
+/// orders far above those that carry the energy (the `slab` model's
+/// forward peak at grazing incidence on a smooth face, `crate::interface`)
+/// that light is broad in azimuth (two refractions) and contributes nothing
+/// there; [`multiple_scattering`]'s full chain gives the lower orders. Made
+/// reciprocal as the full chain's and scaled by `scale_out`, the full
+/// chain's factors of the outside nodes ([`WalkFace::scale`]).
+pub fn outside_reflection(
+    mf: Microfacet,
+    eta: f64,
+    outside: &Grid,
+    orders: usize,
+    q: usize,
+    scale_out: &[f64],
+) -> Result<Vec<DMatrix<f64>>, SlabError> {
+    let s = Microsurface::new(mf, eta);
+    let no = outside.len();
+    // The outside states: up, then down (the order of `states`).
+    let st: Vec<State> = states(outside, outside).into_iter().take(2 * no).collect();
+    let n = st.len();
+    let p = phase_matrices(&s, &st, orders, q);
+    let cont: Vec<f64> = st
+        .iter()
+        .map(|a| a.w * if a.up { 1.0 - s.g1(a.mu) } else { 1.0 })
+        .collect();
+    let wt = outside.reciprocity_weights();
+    p.par_iter()
+        .map(|pm| {
+            let mut mm = pm.clone();
+            for (a, c) in cont.iter().enumerate() {
+                mm.column_mut(a).scale_mut(*c);
+            }
+            let rhs = &mm * pm;
+            let a = DMatrix::identity(n, n) - &mm;
+            let x = a.lu().solve(&rhs).ok_or(SlabError::Singular {
+                step: "the microsurface walk's chain outside the face",
+            })?;
+            // r_top: exit states going up (0..no), arrivals going down (no..2 no).
+            let r = DMatrix::from_fn(no, no, |b, a| {
+                let (sb, sa) = (&st[b], &st[no + a]);
+                sa.w * sa.mu / sb.mu * s.g1(sb.mu) * x[(b, no + a)]
+            });
+            Ok(DMatrix::from_fn(no, no, |o, j| {
+                0.5 * (r[(o, j)] + wt[j] * r[(j, o)] / wt[o]) * scale_out[o] * scale_out[j]
+            }))
+        })
+        .collect()
+}
+
 /// The layer made exactly reciprocal: each block averaged with its image
 /// under the relations of [`crate::layer`] (`W R` symmetric,
 /// `W_bot T_down = (W_top T_up)^T`, `W = diag(w mu / eta^2)`).

@@ -151,6 +151,10 @@ pub struct Discretisation {
     /// Whether rough faces are normalised to core's directional albedo
     /// ([`crate::interface`]); default `true`.
     pub normalise_faces: bool,
+    /// Fourier orders of the walk's reflection from outside of
+    /// `"multiple"` rough faces ([`crate::interface::ProjectedFace::walk_r_top`]);
+    /// 0 (the default) for none, as for a totals-only solve.
+    pub walk_orders: usize,
 }
 
 impl Default for Discretisation {
@@ -162,6 +166,7 @@ impl Default for Discretisation {
             start_thickness: None,
             azimuth_points: DEFAULT_AZIMUTH_POINTS,
             normalise_faces: true,
+            walk_orders: 0,
         }
     }
 }
@@ -290,6 +295,7 @@ impl SlabSpec {
                 orders: disc.orders,
                 azimuth_points: disc.azimuth_points,
                 normalise: disc.normalise_faces,
+                walk_orders: disc.walk_orders,
             };
             face_interface(&bd, fs, &outside, below, &proj)
         };

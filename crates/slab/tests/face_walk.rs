@@ -44,6 +44,7 @@ fn order_one_is_walters_projection() {
             orders: 6,
             azimuth_points: 8,
             normalise: false,
+            walk_orders: 0,
         };
         let walter = face_interface(&bd, FaceScattering::Single, &out, &ins, &proj).unwrap();
         let chain = single_scattering(Microfacet::new(dist, m), 1.5, &out, &ins, 6, 8);
@@ -79,6 +80,7 @@ fn discretised_walk_returns_what_walter_loses() {
             orders: 1,
             azimuth_points: 8,
             normalise: true,
+            walk_orders: 0,
         };
         let walter = face_interface(&bd, FaceScattering::Single, &out, &ins, &proj).unwrap();
         let l = &walter.orders[0];
@@ -132,6 +134,7 @@ fn walk_face_is_reciprocal_in_every_order() {
             orders: 8,
             azimuth_points: 8,
             normalise: true,
+            walk_orders: 0,
         };
         let face = face_interface(&bd, FaceScattering::Multiple, &out, &ins, &proj).unwrap();
         for l in &face.orders {

@@ -182,12 +182,14 @@ fn proj(orders: usize, azimuth_points: usize) -> Projection {
         orders,
         azimuth_points,
         normalise: true,
+        walk_orders: 0,
     }
 }
 
 fn proj_raw(orders: usize, azimuth_points: usize) -> Projection {
     Projection {
         normalise: false,
+        walk_orders: 0,
         ..proj(orders, azimuth_points)
     }
 }

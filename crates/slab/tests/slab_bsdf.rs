@@ -237,7 +237,9 @@ fn energy_is_bounded() {
 /// nearly exact) and on `[0, mu_0]`, each interval also split
 /// in `split` equal parts (for the analytic face's lobe); in azimuth the
 /// midpoint rule with `n_phi` points, exact for the table's Fourier sum when
-/// `n_phi` exceeds twice the orders.
+/// `n_phi` exceeds its highest order (`sum_k cos(m phi_k)` vanishes unless
+/// `n_phi` divides `m`: with 96 points the walk's order 96 of the default
+/// 128, [`SlabOptions::walk_orders`], reads as order 0, -6e-5 at 80 degrees).
 fn grid_albedo(f: impl Fn(DVec3) -> f64, nodes: &[f64], mu_i: f64, per: usize, split: usize, n_phi: usize) -> f64 {
     let (x, w) = paperbsdf_core::quadrature::gauss_legendre_01(per);
     let mut edges = vec![0.0];
@@ -306,6 +308,8 @@ fn grid_albedo(f: impl Fn(DVec3) -> f64, nodes: &[f64], mu_i: f64, per: usize, s
 /// 1.7e-3 at grazing, this was 1.15e-4 up to 50 degrees.
 /// Parts per node interval of the rule in `mu_o`.
 const SURFACE_SPLIT: usize = 8;
+/// Azimuth points of the table's albedo: above the default walk orders (128).
+const TABLE_PHI: usize = 160;
 /// Azimuths of the rule for the analytic lobe.
 const SURFACE_PHI: usize = 768;
 
@@ -350,7 +354,7 @@ fn energy_closes_without_absorption() {
                     wi.z.abs(),
                     3,
                     SURFACE_SPLIT,
-                    96,
+                    TABLE_PHI,
                 );
                 let e = table + b.face_reflectance(face, wi.z.abs()) - 1.0;
                 worst_table = worst_table.max(e.abs());
@@ -660,6 +664,16 @@ fn bad_input_is_an_error() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("orders"), "{e}");
+    let e = SlabBsdf::with_options(
+        &p,
+        &SlabOptions {
+            orders: 64,
+            walk_orders: 48,
+            ..Default::default()
+        },
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("walk_orders"), "{e}");
     // A coated front (eta_f != eta_b: the glossy preset) is no longer an
     // error since the solver has the coating (tests/coated.rs).
     let glossy = preset("glossy").unwrap();
