@@ -170,13 +170,16 @@ pub struct SlabOptions {
     pub orders: usize,
     /// Fourier orders of the light the lit face's microsurface reflects
     /// more than once (`face_scattering = "multiple"`), `orders` to
-    /// [`MAX_ORDERS`]; default 128. At grazing incidence on a smooth face
+    /// [`MAX_ORDERS`]; default 256. At grazing incidence on a smooth face
     /// this light is a forward peak narrower in azimuth than `orders`
-    /// resolve (luster's Beckmann 0.15 front at 75 degrees, seen at 80:
-    /// 6% under its converged value with 48 orders, Fejer-summed); it
-    /// reaches the sheet's reflection unchanged by the layers below, so it
-    /// alone is summed to more orders ([`crate::interface`], module doc
-    /// "Multiple scattering on the microsurface").
+    /// resolve (luster's Beckmann 0.15 front lit at 75 degrees, seen at 80:
+    /// 6.2% under its converged value with 48 orders, Fejer-summed; now
+    /// within 0.001%); it reaches the sheet's reflection unchanged by the
+    /// layers below, so it alone is summed to more orders
+    /// ([`crate::interface`], module doc "Multiple scattering on the
+    /// microsurface"). Each node pair stores only the orders it keeps, so
+    /// the cost is at the grazing pairs: build +0.1 s for luster, memory
+    /// lower than before ([`SlabBsdf::memory_bytes`]).
     pub walk_orders: usize,
     /// Bins in `|phi|` of the sampling density, 1 to 1024.
     pub phi_bins: usize,
@@ -190,7 +193,7 @@ impl Default for SlabOptions {
             nodes: 32,
             tir_nodes: 16,
             orders: 48,
-            walk_orders: 128,
+            walk_orders: 256,
             phi_bins: 32,
             mu_bins: 32,
         }
@@ -291,7 +294,7 @@ const TINY: f64 = 1e-200;
 impl Tables {
     /// Truncates the orders of every node pair (`n` nodes, `orders` orders)
     /// and stores channel 0 alone when `grey` (all channels equal).
-    fn truncate(c: [[Vec<Rgb>; 2]; 2], n: usize, orders: usize, grey: bool) -> Tables {
+    fn truncate(c: [[Vec<Rgb>; 2]; 2], n: usize, orders: [[usize; 2]; 2], grey: bool) -> Tables {
         let mut c = c;
         let mut len: [[Vec<u16>; 2]; 2] = Default::default();
         for tab in c.iter_mut().flatten() {
@@ -303,6 +306,7 @@ impl Tables {
         let magnitude = |v: &Rgb| v.0.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         for (s, side) in c.iter().enumerate() {
             for (t, tab) in side.iter().enumerate() {
+                let orders = orders[s][t];
                 len[s][t] = (0..n * n)
                     .map(|p| {
                         let coef = &tab[p * orders..(p + 1) * orders];
@@ -342,6 +346,7 @@ impl Tables {
             std::array::from_fn(|t| {
                 let mut packed = Vec::new();
                 let mut at = 0u32;
+                let orders = orders[s][t];
                 for (p, &l) in sym[s][t].iter().enumerate() {
                     start[s][t].push(at);
                     at += u32::from(l);
@@ -910,40 +915,46 @@ fn cos_phi(wi: DVec3, wo: DVec3) -> f64 {
     c.clamp(-1.0, 1.0)
 }
 
-/// Whether a node pair's series `sum_m v_m cos(m phi)` (per channel; `v` its
-/// orders) rings below zero by more than [`RING_TOLERANCE`] of its mean:
-/// the mean of its negative part over `4 M` midpoints in `[0, pi]`, where
-/// `eval` would clamp it and so add that much energy. Only where the orders
-/// `m >= 1` could outweigh order 0.
-fn rings_below_zero(v: &[Rgb]) -> bool {
-    (0..3).any(|k| {
-        let c0 = v[0].0[k];
-        let tail: f64 = v[1..].iter().map(|x| x.0[k].abs()).sum();
-        if tail <= c0 {
-            return false;
+/// The mean over azimuth of the negative part of a node pair's series
+/// `sum_m v_m cos(m phi)` in channel `k` (`v` its orders): what `eval`'s
+/// clamp at 0 adds there. By the midpoint rule with `2 M` points in
+/// `[0, pi]` (`2 M`: the negative part is a small correction, not a
+/// resolved function); 0 without computing when the orders `m >= 1` cannot
+/// outweigh order 0.
+fn negative_mass(v: &[Rgb], k: usize) -> f64 {
+    let c0 = v[0].0[k];
+    let tail: f64 = v[1..].iter().map(|x| x.0[k].abs()).sum();
+    if tail <= c0 {
+        return 0.0;
+    }
+    // Trailing zero orders (pairs the walk's high orders do not reach) cost nothing.
+    let v = &v[..v.iter().rposition(|x| x.0[k] != 0.0).map_or(1, |i| i + 1)];
+    let points = 2 * v.len();
+    // The Chebyshev recurrence at all points at once (independent, so the
+    // loop over points vectorises).
+    let c: Vec<f64> = (0..points)
+        .map(|i| (PI * (i as f64 + 0.5) / points as f64).cos())
+        .collect();
+    let mut prev = c.clone();
+    let mut cur = vec![1.0; points];
+    let mut f = vec![0.0; points];
+    for x in v {
+        let a = x.0[k];
+        for i in 0..points {
+            f[i] += a * cur[i];
+            let next = 2.0 * c[i] * cur[i] - prev[i];
+            prev[i] = cur[i];
+            cur[i] = next;
         }
-        let points = 4 * v.len();
-        let negative: f64 = (0..points)
-            .map(|i| {
-                let c = (PI * (i as f64 + 0.5) / points as f64).cos();
-                let (mut prev, mut cur, mut f) = (c, 1.0, 0.0);
-                for x in v {
-                    f += x.0[k] * cur;
-                    let next = 2.0 * c * cur - prev;
-                    prev = cur;
-                    cur = next;
-                }
-                (-f).max(0.0)
-            })
-            .sum::<f64>()
-            / points as f64;
-        negative > RING_TOLERANCE * c0.abs().max(TINY)
-    })
+    }
+    f.iter().map(|&x| (-x).max(0.0)).sum::<f64>() / points as f64
 }
 
-/// How much of a node pair's mean the walk's window may ring below zero
-/// ([`rings_below_zero`]): the energy `eval`'s clamping adds, well below
-/// the 2e-5 the interpolated tables are balanced to.
+/// How much more of a node pair's mean (order 0 of its reflection) the
+/// walk's window may ring below zero than with Fejer's weights to the same
+/// orders ([`negative_mass`], the table and its unscattered part): energy
+/// `eval`'s clamp adds, well below the 2e-5 the interpolated tables are
+/// balanced to.
 const RING_TOLERANCE: f64 = 1e-5;
 
 /// The Fourier series `sum_m s_m cos(m phi)` (`c = cos phi`) of the three
@@ -1143,6 +1154,9 @@ impl SlabBsdf {
         // The table's orders: the solution's, and the walk's reflection from
         // outside to more (`SlabOptions::walk_orders`) when a face has it.
         let m_solved = opts.orders;
+        // The walk's reflection to its orders is flat to half of them
+        // (`interface::walk_window`; 0 would be Fejer's weights).
+        let flat = opts.walk_orders / 2;
         // The weights the solution's orders carry the walk with (crate::interface).
         let fejer = |m: usize| {
             if m < m_solved {
@@ -1244,33 +1258,39 @@ impl SlabBsdf {
                 .collect()
         };
         let cross = [crossing(Side::Front), crossing(Side::Back)];
+        // A grey sheet: every channel is the same solution.
+        let grey = solution_of.iter().all(|&k| k == solution_of[0]);
         let mut table: [[Vec<Rgb>; 2]; 2] = Default::default();
         let mut direct: [[Vec<Rgb>; 2]; 2] = Default::default();
+        // The walk's reflection past the solution's orders, per side: orders
+        // `m_solved..m_count` of each node pair, the same in the table and
+        // its unscattered part (`extra_len` per pair).
+        let extra_len = m_count - m_solved;
+        let mut extra: [Vec<Rgb>; 2] = Default::default();
         for side in 0..2 {
+            // The lit face's walk reflection beyond Fejer's sum (module doc).
+            let walk_r = &prepared.faces[side].walk_r_top;
+            // The table's factor of pair (o, j)'s orders m >= 1 in reflection.
+            let scale_r = |o: usize, j: usize| 2.0 / (2.0 * PI * g.w[j] * g.mu[j]) * cross[side][j] * cross[side][o];
             for (t, transmit) in [false, true].into_iter().enumerate() {
-                let mut tab = vec![Rgb::ZERO; n * n * m_count];
-                let mut dir = vec![Rgb::ZERO; n * n * m_count];
+                let mut tab = vec![Rgb::ZERO; n * n * m_solved];
+                let mut dir = vec![Rgb::ZERO; n * n * m_solved];
                 for (c, &k) in solution_of.iter().enumerate() {
                     let (full, unsc) = &solutions[k];
-                    // The lit face's walk reflection beyond Fejer's sum (module doc).
-                    let walk_r = &prepared.faces[side].walk_r_top;
-                    for m in 0..m_count {
+                    for m in 0..m_solved {
                         let eps = if m == 0 { 1.0 } else { 2.0 };
-                        let solved =
-                            (m < m_solved).then(|| (block(full, side, transmit, m), block(unsc, side, transmit, m)));
+                        let (kf, ku) = (block(full, side, transmit, m), block(unsc, side, transmit, m));
                         let walk = walk_r.get(m).filter(|_| !transmit);
                         for o in 0..n {
                             for j in 0..n {
                                 let exit = if transmit { 1 - side } else { side };
                                 let scale = eps / (2.0 * PI * g.w[j] * g.mu[j]) * cross[side][j] * cross[exit][o];
-                                let gain = walk.map_or(0.0, |w| w[(o, j)] * (walk_window(m, m_count) - fejer(m)));
-                                let (vt, vd) = match solved {
-                                    None => (gain, gain),
-                                    Some((kf, ku)) if both_smooth => (kf[(o, j)] - ku[(o, j)], 0.0),
-                                    Some((kf, ku)) => {
-                                        let surface = if transmit { 0.0 } else { face_r(side, m)[(o, j)] };
-                                        (kf[(o, j)] - surface + gain, ku[(o, j)] - surface + gain)
-                                    }
+                                let gain = walk.map_or(0.0, |w| w[(o, j)] * (walk_window(m, m_count, flat) - fejer(m)));
+                                let (vt, vd) = if both_smooth {
+                                    (kf[(o, j)] - ku[(o, j)], 0.0)
+                                } else {
+                                    let surface = if transmit { 0.0 } else { face_r(side, m)[(o, j)] };
+                                    (kf[(o, j)] - surface + gain, ku[(o, j)] - surface + gain)
                                 };
                                 // At normal incidence or exit (the node mu = 1)
                                 // nothing depends on azimuth: orders m >= 1
@@ -1280,7 +1300,7 @@ impl SlabBsdf {
                                 } else {
                                     (vt, vd)
                                 };
-                                let idx = (o * n + j) * m_count + m;
+                                let idx = (o * n + j) * m_solved + m;
                                 tab[idx].0[c] = vt * scale;
                                 dir[idx].0[c] = vd * scale;
                             }
@@ -1290,34 +1310,86 @@ impl SlabBsdf {
                 table[side][t] = tab;
                 direct[side][t] = dir;
             }
-            // Node pairs whose reflection with the walk summed to its orders
-            // goes below zero anywhere in azimuth (the walk's peak narrower
-            // than even those orders resolve: GGX 0.1 at 85 degrees) take
-            // Fejer's weights to its orders instead, which keep it
-            // non-negative (module doc, "Orders").
-            let walk_r = &prepared.faces[side].walk_r_top;
-            if walk_r.len() > m_solved {
-                let rings = |o: usize, j: usize| -> bool {
-                    [&table[side][0], &direct[side][0]]
-                        .iter()
-                        .any(|tab| rings_below_zero(&tab[(o * n + j) * m_count..(o * n + j + 1) * m_count]))
-                };
-                let fallback: Vec<(usize, usize)> = (0..n * n)
-                    .into_par_iter()
-                    .filter_map(|p| {
-                        let (o, j) = (p / n, p % n);
-                        (o <= j && (rings(o, j) || rings(j, o))).then_some((o, j))
+            if extra_len == 0 {
+                continue;
+            }
+            extra[side] = (0..n * n)
+                .flat_map(|p| {
+                    let (o, j) = (p / n, p % n);
+                    let pole = o == n - 1 || j == n - 1;
+                    (m_solved..m_count).map(move |m| {
+                        let w = walk_r.get(m).map_or(0.0, |w| w[(o, j)]);
+                        if pole {
+                            Rgb::ZERO
+                        } else {
+                            Rgb::splat(w * walk_window(m, m_count, flat) * scale_r(o, j))
+                        }
                     })
-                    .collect();
-                for (a, b) in fallback {
-                    for (o, j) in [(a, b), (b, a)] {
-                        let scale = 2.0 / (2.0 * PI * g.w[j] * g.mu[j]) * cross[side][j] * cross[side][o];
-                        for (m, w) in walk_r.iter().enumerate().skip(1) {
-                            let d = w[(o, j)] * ((1.0 - m as f64 / m_count as f64) - walk_window(m, m_count)) * scale;
-                            let idx = (o * n + j) * m_count + m;
-                            for tab in [&mut table[side][0], &mut direct[side][0]] {
-                                tab[idx] += Rgb::splat(d);
-                            }
+                })
+                .collect();
+            // Node pairs whose reflection with the walk summed to its orders
+            // (window flat to half of them) rings below zero by more than
+            // RING_TOLERANCE of their mean where Fejer's weights to the same
+            // orders would not (the walk's peak narrower than even those
+            // orders resolve: luster's Beckmann 0.15 front beyond 85
+            // degrees, GGX 0.1 at 85) take Fejer's weights: `eval` clamps at
+            // 0, which would add that energy.
+            let ks = if grey { 1 } else { 3 };
+            // What pair (o, j)'s order m gains when Fejer's weights replace the flat window.
+            let to_fejer = |o: usize, j: usize, m: usize| -> f64 {
+                if m == 0 || o == n - 1 || j == n - 1 {
+                    return 0.0;
+                }
+                walk_r[m][(o, j)] * (walk_window(m, m_count, 0) - walk_window(m, m_count, flat)) * scale_r(o, j)
+            };
+            let rings = |o: usize, j: usize| -> bool {
+                let p = o * n + j;
+                let mean = table[side][0][p * m_solved];
+                // The walk's orders past the flat part bound how far the
+                // flat window's sum is from the (non-negative) whole series,
+                // and so its negative part: most pairs end here.
+                let beyond: f64 = walk_r[flat + 1..].iter().map(|w| w[(o, j)].abs()).sum::<f64>() * scale_r(o, j);
+                if (0..ks).all(|k| beyond <= RING_TOLERANCE * mean.0[k].abs()) {
+                    return false;
+                }
+                let high = &extra[side][p * extra_len..(p + 1) * extra_len];
+                let change: Vec<f64> = (0..m_count).map(|m| to_fejer(o, j, m)).collect();
+                (0..ks).any(|k| {
+                    let excess: f64 = [&table[side][0], &direct[side][0]]
+                        .iter()
+                        .map(|tab| {
+                            let series: Vec<Rgb> = tab[p * m_solved..(p + 1) * m_solved]
+                                .iter()
+                                .chain(high)
+                                .copied()
+                                .collect();
+                            let fejer: Vec<Rgb> =
+                                series.iter().zip(&change).map(|(v, d)| *v + Rgb::splat(*d)).collect();
+                            negative_mass(&series, k) - negative_mass(&fejer, k)
+                        })
+                        .sum();
+                    excess > RING_TOLERANCE * mean.0[k].abs()
+                })
+            };
+            let fallback: Vec<(usize, usize)> = (0..n * n)
+                .into_par_iter()
+                .filter_map(|p| {
+                    let (o, j) = (p / n, p % n);
+                    // A pair and its reciprocal are the same series up to a
+                    // positive factor: one check for both.
+                    (o <= j && rings(o, j)).then_some((o, j))
+                })
+                .collect();
+            for (a, b) in fallback {
+                for (o, j) in [(a, b), (b, a)] {
+                    let p = o * n + j;
+                    for m in 1..m_count {
+                        let d = Rgb::splat(to_fejer(o, j, m));
+                        if m < m_solved {
+                            table[side][0][p * m_solved + m] += d;
+                            direct[side][0][p * m_solved + m] += d;
+                        } else {
+                            extra[side][p * extra_len + m - m_solved] += d;
                         }
                     }
                 }
@@ -1327,16 +1399,14 @@ impl SlabBsdf {
         // the lit face lets in, `1 - r`, with `r` what `eval` adds analytically.
         let linear_shape = [Side::Front, Side::Back].map(|side| crossing_shape(&g.mu, |m| face_r_at(side, m)));
         let mut shape = linear_shape.clone().map(|g| [g.clone(), g.clone(), g]);
-        // A grey sheet: every channel is the same solution.
-        let grey = solution_of.iter().all(|&k| k == solution_of[0]);
         let unbalanced = (table.clone(), direct.clone());
-        let mut balance = balance_interpolation(&mut table, &mut direct, &g.mu, &g.w, &cross, &shape, m_count);
+        let mut balance = balance_interpolation(&mut table, &mut direct, &g.mu, &g.w, &cross, &shape, m_solved);
         // The triangles' albedo between the nodes of `mu_i` (ridge_ratios),
         // folded into the crossing shapes, which changes the exit weights of
         // the balance: the solution rebalanced, a few passes.
         for _ in 0..RIDGE_PASSES {
             for c in 0..3 {
-                let ratio = ridge_ratios(&table, &g.mu, [&shape[0][c], &shape[1][c]], m_count, c);
+                let ratio = ridge_ratios(&table, &g.mu, [&shape[0][c], &shape[1][c]], m_solved, c);
                 for ((g_side, g_lin), r) in shape.iter_mut().zip(&linear_shape).zip(&ratio) {
                     for ((x, x_lin), f) in g_side[c].iter_mut().zip(g_lin).zip(r) {
                         *x = x_lin * f;
@@ -1344,11 +1414,35 @@ impl SlabBsdf {
                 }
             }
             (table, direct) = unbalanced.clone();
-            balance = balance_interpolation(&mut table, &mut direct, &g.mu, &g.w, &cross, &shape, m_count);
+            balance = balance_interpolation(&mut table, &mut direct, &g.mu, &g.w, &cross, &shape, m_solved);
+        }
+        // The walk's orders past the solution's, balanced as the rest of
+        // their pairs (factors x_o x_j on the lit side), joined to the
+        // reflection tables.
+        let mut orders = [[m_solved; 2]; 2];
+        if extra_len > 0 {
+            for side in 0..2 {
+                let join = |tab: &[Rgb]| -> Vec<Rgb> {
+                    (0..n * n)
+                        .flat_map(|p| {
+                            let (o, j) = (p / n, p % n);
+                            let f = balance[side][o].zip(balance[side][j], |a, b| a * b);
+                            tab[p * m_solved..(p + 1) * m_solved].iter().copied().chain(
+                                extra[side][p * extra_len..(p + 1) * extra_len]
+                                    .iter()
+                                    .map(move |v| v.zip(f, |a, b| a * b)),
+                            )
+                        })
+                        .collect()
+                };
+                table[side][0] = join(&table[side][0]);
+                direct[side][0] = join(&direct[side][0]);
+                orders[side][0] = m_count;
+            }
         }
         let (table, direct) = (
-            Tables::truncate(table, n, m_count, grey),
-            Tables::truncate(direct, n, m_count, grey),
+            Tables::truncate(table, n, orders, grey),
+            Tables::truncate(direct, n, orders, grey),
         );
         let smooth = both_smooth.then(|| SmoothSheet {
             eta_f: specs[0].front.eta(),

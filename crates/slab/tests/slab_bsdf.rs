@@ -238,8 +238,8 @@ fn energy_is_bounded() {
 /// in `split` equal parts (for the analytic face's lobe); in azimuth the
 /// midpoint rule with `n_phi` points, exact for the table's Fourier sum when
 /// `n_phi` exceeds its highest order (`sum_k cos(m phi_k)` vanishes unless
-/// `n_phi` divides `m`: with 96 points the walk's order 96 of the default
-/// 128, [`SlabOptions::walk_orders`], reads as order 0, -6e-5 at 80 degrees).
+/// `n_phi` divides `m`: with 96 points the walk's order 96, of the default
+/// 256 [`SlabOptions::walk_orders`], read as order 0, -6e-5 at 80 degrees).
 fn grid_albedo(f: impl Fn(DVec3) -> f64, nodes: &[f64], mu_i: f64, per: usize, split: usize, n_phi: usize) -> f64 {
     let (x, w) = paperbsdf_core::quadrature::gauss_legendre_01(per);
     let mut edges = vec![0.0];
@@ -308,8 +308,8 @@ fn grid_albedo(f: impl Fn(DVec3) -> f64, nodes: &[f64], mu_i: f64, per: usize, s
 /// 1.7e-3 at grazing, this was 1.15e-4 up to 50 degrees.
 /// Parts per node interval of the rule in `mu_o`.
 const SURFACE_SPLIT: usize = 8;
-/// Azimuth points of the table's albedo: above the default walk orders (128).
-const TABLE_PHI: usize = 160;
+/// Azimuth points of the table's albedo: above the default walk orders (256).
+const TABLE_PHI: usize = 272;
 /// Azimuths of the rule for the analytic lobe.
 const SURFACE_PHI: usize = 768;
 

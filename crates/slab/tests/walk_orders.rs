@@ -31,15 +31,15 @@ fn peak_values(b: &SlabBsdf) -> Vec<(String, f64)> {
     v
 }
 
-/// Doubling the orders (48 -> 96) and the walk's orders (128 -> 256).
-/// Where the walk's peak is resolved by its 128 orders its window is flat
-/// to order 64 and the value moves by less than 0.2% (the bound);
-/// luster's and matte's grazing node pairs still ring below zero with 128
-/// orders and keep Fejer's weights to 128 (src/bsdf.rs, `rings_below_zero`),
-/// which leaves luster's peak 2.4-3.6% under the doubled solve (whose 256
-/// orders resolve it: 512 give the same to 1e-5); lit from the back
-/// (luster's rougher back face) 0.003%. Asserted: within 4%, and closer
-/// than with the walk summed to the sheet's 48 orders (4.6-6.2% under it).
+/// Doubling the orders (48 -> 96) and the walk's orders (256 -> 512)
+/// moves the peak by less than 0.2% (the bound), and the default is
+/// closer to the doubled solve than with the walk summed to the sheet's 48
+/// orders with Fejer's weights (before 2026-12-05: luster 4.6-6.2% under it
+/// lit from the front, 1.1-1.2% from the back). Measured: at most 0.001%
+/// at 60 and 75 degrees. At 85 R -85 the walk's peak is narrower than 256
+/// orders resolve at the node pairs beyond 85 degrees, which keep Fejer's
+/// weights (src/bsdf.rs, `negative_mass`): 2.2% under (4.9% before),
+/// asserted within 3%.
 #[test]
 fn the_walks_forward_peak_converges_in_the_orders() {
     for name in ["luster", "matte"] {
@@ -65,7 +65,8 @@ fn the_walks_forward_peak_converges_in_the_orders() {
                 100.0 * rel,
                 100.0 * rel_old
             );
-            assert!(rel.abs() < 4e-2, "{name} {at}: {v} against {f} with twice the orders");
+            let bound = if at.contains(" 85 R ") { 3e-2 } else { 2e-3 };
+            assert!(rel.abs() < bound, "{name} {at}: {v} against {f} with twice the orders");
             assert!(
                 rel.abs() <= rel_old.abs() + 1e-4,
                 "{name} {at}: {v} is farther from {f} than the walk to 48 orders, {o}"
@@ -77,8 +78,8 @@ fn the_walks_forward_peak_converges_in_the_orders() {
 /// The orders above the sheet's come from the walk's chain restricted to
 /// the outside states (`face_walk::outside_reflection`), those below from
 /// the full chain. Solving the sheet to 96 orders instead of 48 takes the
-/// orders 48..96 from the full chain instead: the two agree within 1e-3
-/// (measured ...): the light that refracts into the face on its way is
+/// orders 48..96 from the full chain instead: the two agree within 1e-4
+/// (measured 7.7e-6, lit from the back): the light that refracts into the face on its way is
 /// broad in azimuth and has almost no part in the orders above 48. A chain
 /// that dropped a block, scaled differently or had the orders' signs wrong
 /// would be off by percent.
@@ -98,6 +99,6 @@ fn the_outside_chain_gives_the_full_chains_high_orders() {
     for ((at, v), (_, f)) in peak_values(&b).iter().zip(peak_values(&full)) {
         let rel = v / f - 1.0;
         eprintln!("{at}: {v:.6} / {f:.6} {:+.2e}", rel);
-        assert!(rel.abs() < 1e-3, "{at}: {v} against the full chain's {f}");
+        assert!(rel.abs() < 1e-4, "{at}: {v} against the full chain's {f}");
     }
 }
