@@ -97,9 +97,10 @@
 //! forward peak at grazing incidence on smooth faces (luster's Beckmann
 //! 0.15 front at 75 degrees, 8% under the simulator at `theta_o = -80` with
 //! 32 orders; the model's default is therefore 48, `crate::SlabOptions`).
-//! That peak is narrower in azimuth than 48 orders resolve, so it is not
-//! converged in the orders: doubling them moves the in-plane value at
-//! `theta_o = -80` by 3.1% (crates/slab/examples/convergence.rs). Jackson's
+//! That peak is narrower in azimuth than 48 orders resolve, so it was not
+//! converged in the orders: doubling them moved the in-plane value at
+//! `theta_o = -80` by 3.1% (crates/slab/examples/convergence.rs), hence the
+//! walk's own orders below. Jackson's
 //! kernel (non-negative too, RMS width `pi / M` where Fejer's tails give 14
 //! degrees at 48 orders) was tried and not kept: better for lobes broader
 //! than `pi / M`, worse for this one, as its main lobe is wider than

@@ -68,7 +68,7 @@
 //! no separate `single` component). The projected faces' R/T split (1e-3
 //! off) no longer reaches the BSDF: the table is rescaled to the
 //! transmittance the analytic face's own albedo leaves ([`bsdf`]). Builds
-//! take 0.6 to 0.95 s for the presets (the coated glossy sheet the
+//! take 0.67 to 0.94 s for the presets (the coated glossy sheet the
 //! slowest). Near `eta_f = eta_b` from
 //! below (the base denser) the discretisation moves with the boundary's
 //! critical cosine, by `O(sqrt(eta_b - eta_f))` (8e-5 in the totals at a
