@@ -224,29 +224,13 @@ pub fn multiple_scattering(
     let [lost_out, lost_in] = lost;
     let s = Microsurface::new(mf, eta);
     let st = states(outside, inside);
-    let n = st.len();
     let (no, ni) = (outside.len(), inside.len());
     let p = phase_matrices(&s, &st, orders, q);
-    let cont: Vec<f64> = st
-        .iter()
-        .map(|a| a.w * if a.up { 1.0 - s.g1(a.mu) } else { 1.0 })
-        .collect();
-    let layers: Vec<Layer> = p
+    let layers: Vec<Layer> = scattered_twice_or_more(&s, &st, &p, "the microsurface walk's chain")?
         .par_iter()
         .enumerate()
-        .map(|(m, pm)| {
-            let mut mm = pm.clone();
-            for (a, c) in cont.iter().enumerate() {
-                mm.column_mut(a).scale_mut(*c);
-            }
-            let rhs = &mm * pm;
-            let a = DMatrix::identity(n, n) - &mm;
-            let x = a.lu().solve(&rhs).ok_or(SlabError::Singular {
-                step: "the microsurface walk's chain",
-            })?;
-            Ok(symmetrised(to_layer(&s, &st, &x, m, no, ni), outside, inside))
-        })
-        .collect::<Result<_, SlabError>>()?;
+        .map(|(m, x)| symmetrised(to_layer(&s, &st, x, m, no, ni), outside, inside))
+        .collect();
     let raw_albedo = albedos(&layers[0], outside, inside);
     // Nodes the discretised walk does not resolve (module doc) keep their
     // loss for the caller; the walk is scaled to the others.
@@ -328,13 +312,43 @@ pub fn outside_reflection(
             })
         })
         .collect();
-    let n = st.len();
     let p = phase_matrices_from(&s, &st, orders.start, orders.end, q);
+    let wt = outside.reciprocity_weights();
+    let xs = scattered_twice_or_more(&s, &st, &p, "the microsurface walk's chain outside the face")?;
+    Ok(xs
+        .par_iter()
+        .map(|x| {
+            // r_top: exit states going up (0..no), arrivals going down (no..2 no).
+            let r = DMatrix::from_fn(no, no, |b, a| {
+                let (sb, sa) = (&st[b], &st[no + a]);
+                sa.w * sa.mu / sb.mu * s.g1(sb.mu) * x[(b, no + a)]
+            });
+            DMatrix::from_fn(no_all, no_all, |o, j| {
+                if o < no && j < no {
+                    0.5 * (r[(o, j)] + wt[j] * r[(j, o)] / wt[o]) * scale_out[o] * scale_out[j]
+                } else {
+                    0.0
+                }
+            })
+        })
+        .collect())
+}
+
+/// The chain's light scattered twice or more before its escape, per order
+/// (module doc): `X = (I - M)^-1 M P` with `M = P diag(w_a C_a)`, for the
+/// states `st` and their phase matrices `p`; `step` names the chain in the
+/// error of a singular system.
+fn scattered_twice_or_more(
+    s: &Microsurface,
+    st: &[State],
+    p: &[DMatrix<f64>],
+    step: &'static str,
+) -> Result<Vec<DMatrix<f64>>, SlabError> {
+    let n = st.len();
     let cont: Vec<f64> = st
         .iter()
         .map(|a| a.w * if a.up { 1.0 - s.g1(a.mu) } else { 1.0 })
         .collect();
-    let wt = outside.reciprocity_weights();
     p.par_iter()
         .map(|pm| {
             let mut mm = pm.clone();
@@ -343,21 +357,7 @@ pub fn outside_reflection(
             }
             let rhs = &mm * pm;
             let a = DMatrix::identity(n, n) - &mm;
-            let x = a.lu().solve(&rhs).ok_or(SlabError::Singular {
-                step: "the microsurface walk's chain outside the face",
-            })?;
-            // r_top: exit states going up (0..no), arrivals going down (no..2 no).
-            let r = DMatrix::from_fn(no, no, |b, a| {
-                let (sb, sa) = (&st[b], &st[no + a]);
-                sa.w * sa.mu / sb.mu * s.g1(sb.mu) * x[(b, no + a)]
-            });
-            Ok(DMatrix::from_fn(no_all, no_all, |o, j| {
-                if o < no && j < no {
-                    0.5 * (r[(o, j)] + wt[j] * r[(j, o)] / wt[o]) * scale_out[o] * scale_out[j]
-                } else {
-                    0.0
-                }
-            }))
+            a.lu().solve(&rhs).ok_or(SlabError::Singular { step })
         })
         .collect()
 }
