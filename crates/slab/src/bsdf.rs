@@ -1314,6 +1314,13 @@ impl SlabBsdf {
             if extra_len == 0 {
                 continue;
             }
+            if walk_r.len() < m_count {
+                // This face has no walk reflection past the solution's orders
+                // (a smooth face, Walter's face alone, or a walk the grid does
+                // not resolve) while the other face has.
+                extra[side] = vec![Rgb::ZERO; n * n * extra_len];
+                continue;
+            }
             extra[side] = (0..n * n)
                 .flat_map(|p| {
                     let (o, j) = (p / n, p % n);
