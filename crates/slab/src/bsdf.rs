@@ -180,7 +180,9 @@ pub struct SlabOptions {
     /// microsurface"). Each node pair stores only the orders it keeps, so
     /// the cost is at the grazing pairs (memory, [`SlabBsdf::memory_bytes`],
     /// below what 48 orders at every pair took); the restricted chain that
-    /// gives the orders above `orders` costs 0.02-0.05 s per face.
+    /// gives the orders above `orders` costs 0.02-0.05 s per face (timed
+    /// inside the build while writing it; examples/walk_orders.rs gives the
+    /// whole build against `walk_orders`).
     pub walk_orders: usize,
     /// Bins in `|phi|` of the sampling density, 1 to 1024.
     pub phi_bins: usize,
@@ -293,7 +295,8 @@ const ORDER_CUTOFF: f64 = 1e-5;
 const TINY: f64 = 1e-200;
 
 impl Tables {
-    /// Truncates the orders of every node pair (`n` nodes, `orders` orders)
+    /// Truncates the orders of every node pair (`n` nodes; `orders[side][transmit]`
+    /// orders per pair in `c`), packs each pair's kept orders ([`Tables::start`])
     /// and stores channel 0 alone when `grey` (all channels equal).
     fn truncate(c: [[Vec<Rgb>; 2]; 2], n: usize, orders: [[usize; 2]; 2], grey: bool) -> Tables {
         let mut c = c;
@@ -1158,14 +1161,6 @@ impl SlabBsdf {
         // The walk's reflection to its orders is flat to half of them
         // (`interface::walk_window`; 0 would be Fejer's weights).
         let flat = opts.walk_orders / 2;
-        // The weights the solution's orders carry the walk with (crate::interface).
-        let fejer = |m: usize| {
-            if m < m_solved {
-                1.0 - m as f64 / m_solved as f64
-            } else {
-                0.0
-            }
-        };
         let m_count = prepared
             .faces
             .iter()
@@ -1286,7 +1281,10 @@ impl SlabBsdf {
                             for j in 0..n {
                                 let exit = if transmit { 1 - side } else { side };
                                 let scale = eps / (2.0 * PI * g.w[j] * g.mu[j]) * cross[side][j] * cross[exit][o];
-                                let gain = walk.map_or(0.0, |w| w[(o, j)] * (walk_window(m, m_count, flat) - fejer(m)));
+                                let gain = walk.map_or(0.0, |w| {
+                                    // The solution carries the walk with Fejer's weights to its orders (crate::interface).
+                                    w[(o, j)] * (walk_window(m, m_count, flat) - walk_window(m, m_solved, 0))
+                                });
                                 let (vt, vd) = if both_smooth {
                                     (kf[(o, j)] - ku[(o, j)], 0.0)
                                 } else {
@@ -1564,9 +1562,8 @@ impl SlabBsdf {
 
     /// [`SlabBsdf::eval_table`] with the directions placed among the nodes
     /// and `c` the cosine of their azimuth difference ([`cos_phi`]). The three
-    /// corners (node pairs) are weighted first and summed in one Fourier
-    /// series over the longest of their orders (orders past a pair's length
-    /// are zero, [`Tables::truncate`]).
+    /// corners (node pairs) are summed with their weights, each over the
+    /// orders it keeps ([`fourier_sum`]; near the pole [`fourier_sum_pole`]).
     #[inline]
     fn eval_table_at(&self, tab: &Tables, wi: Place, wo: Place, c: f64) -> Rgb {
         let side = usize::from(wi.z < 0.0);

@@ -118,7 +118,8 @@
 //! the solve with twice the orders before, is now within 0.001% of it
 //! (tests/walk_orders.rs). Windows between the two (flat to 16, 32 or 48
 //! of 128 orders, then linear) were tried at the pairs that ring: every one
-//! rang more than Fejer's by over 1e-5 of the pair's mean.
+//! rang more than Fejer's by over 1e-5 of the pair's mean (a trial while
+//! writing this, not kept as a command).
 //! The walk integrates with half the azimuth points per panel of Walter's
 //! projection (its kernels are integrated again over the intermediate
 //! directions; luster at 75 degrees: the same RMS error to 1e-4, build 15%
@@ -612,7 +613,9 @@ fn column_albedo(k: &DMatrix<f64>, to: &Grid, from: &Grid, j: usize) -> f64 {
 /// normal; [`crate::face_walk::outside_reflection`]): nearer the normal its
 /// orders above 48 are nil (luster and matte: the in-plane values with the
 /// cut at 60 degrees, at 50 degrees and without it agree to every one of 6
-/// printed digits, from 30 R -30 to 85 R -85, measured 2026-12-05), and the
+/// printed digits, from 30 R -30 to 85 R -85, measured 2026-12-05 by
+/// rebuilding with this constant changed; examples/walk_orders.rs prints
+/// those points), and the
 /// chain on 13 of the 32 nodes costs a sixth.
 pub const WALK_GRAZING_MU: f64 = 0.5;
 
