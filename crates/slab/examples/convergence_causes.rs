@@ -9,8 +9,7 @@
 //!   (8.87 and 12.85 with 32 nodes) and at 10 degrees between them, around
 //!   its straight-through peak, and 2.5 degrees either side of the normal;
 //! - thin tissue lit at 2.5 degrees (inside the last interval of nodes),
-//!   seen from -20 to 20 degrees, and lit at the normal (where only order
-//!   0 counts), seen between the nodes.
+//!   seen from -20 to 20 degrees.
 //!
 //! `cargo run --release -p paperbsdf-slab --example convergence_causes`
 
@@ -79,8 +78,5 @@ fn main() {
         nodes[n - 2].acos().to_degrees()
     );
     let pts: Vec<(f64, f64, bool)> = (-8..=8).map(|k| (2.5, 2.5 * k as f64, true)).collect();
-    row(&t, &pts);
-    println!("thin-tissue lit at the normal (order 0 only), seen between the nodes:");
-    let pts: Vec<(f64, f64, bool)> = (1..=8).map(|k| (0.0, 2.0 * k as f64, true)).collect();
     row(&t, &pts);
 }

@@ -60,20 +60,17 @@
 //! (`ridge_ratios`, exact integrals of the rows) fold the difference into
 //! the crossing shapes below, per channel. Three node pairs instead of four
 //! also make `eval` cheaper. Near the pole (the last interval, between the
-//! node before `mu = 1` and `mu = 1`, 4.85 degrees with 32 nodes) a smooth
-//! function's orders on the sphere are `sin^m theta h_m` with `h_m` smooth
-//! in `mu`: there the orders `m >= 1` are `rho^m` times `h_m` extrapolated
-//! linearly in `mu` from the two nodes before the pole, `rho = sin theta /
-//! sin theta_{n-2}`, and interpolated linearly in the other direction's `mu`
-//! (`pole_corners`; order 0 stays the triangles'). Linear weights in `mu`
-//! let every order fall like `theta^2`, which halved order 1 there (a thin
-//! sheet's transmission 2.5 degrees from the normal: 8% off, of opposite
-//! signs either side; 0.8% against twice the nodes with `h_m` held at the
-//! node before the pole, 0.5% extrapolated), and the triangles took the
-//! orders `m >= 1` of light arriving near the normal from one node of
-//! `mu_o` (6.9% from twice the nodes at 10 degrees; 4.8% at 6 degrees with
-//! `h_m` held, until 2026-12-05, 3.2% extrapolated;
-//! examples/convergence_causes.rs). The Fourier sum can ring below
+//! node before `mu = 1` and `mu = 1`, 4.85 degrees with 32 nodes) the orders
+//! `m >= 1` of the node before it are carried with weight `rho^m`, `rho =
+//! sin theta / sin theta_{n-2}`, as a smooth function's on the sphere fall,
+//! and interpolated linearly in the other direction's `mu` (`pole_corners`;
+//! order 0 stays the triangles'). Linear weights in `mu` let every order
+//! fall like `theta^2`, which halved order 1 there (a thin sheet's
+//! transmission 2.5 degrees from the normal: 8% off, of opposite signs
+//! either side; now 0.8% against twice the nodes), and the triangles took
+//! the orders `m >= 1` of light arriving near the normal from one node of
+//! `mu_o` (6.9% from twice the nodes at 10 degrees, now 3.6%;
+//! examples/convergence.rs). The Fourier sum can ring below
 //! zero for lobes narrower than the orders resolve: `eval` returns `max(f,
 //! 0)` per channel.
 //!
@@ -994,9 +991,8 @@ fn fourier_sum<const K: usize>(tab: &Tables, st: usize, pairs: [usize; 3], weigh
 
 /// The table near the pole ([`pole_corners`]): order 0 from the triangles'
 /// three node pairs `pairs` and `weights` (as [`fourier_sum`]), the orders
-/// `m >= 1` from the four node pairs of `pole`, each with its weight and its
-/// `r`, summed with `r^m cos(m phi)` by the recurrence
-/// `a_{m+1} = 2 r c a_m - r^2 a_{m-1}`.
+/// `m >= 1` from the two node pairs of `pole` with their weights, summed with
+/// `r^m cos(m phi)` by the recurrence `a_{m+1} = 2 r c a_m - r^2 a_{m-1}`.
 fn fourier_sum_pole<const K: usize>(
     tab: &Tables,
     st: usize,
@@ -1013,11 +1009,11 @@ fn fourier_sum_pole<const K: usize>(
             *a += w * t[start[p] as usize * K + k];
         }
     }
-    for ((&p, &w), &r) in pole.pairs.iter().zip(&pole.weights).zip(&pole.r) {
+    let (rc, r2) = (pole.r * c, pole.r * pole.r);
+    for (&p, &w) in pole.pairs.iter().zip(&pole.weights) {
         if w == 0.0 {
             continue;
         }
-        let (rc, r2) = (r * c, r * r);
         let from = start[p] as usize * K;
         let row = &t[from..from + len[p] as usize * K];
         let (mut a_prev, mut a_m) = (w, w * rc);
@@ -1033,75 +1029,58 @@ fn fourier_sum_pole<const K: usize>(
     acc
 }
 
-/// The node pairs, weights and ratios `r` of the orders `m >= 1` near the
-/// pole (module doc, "Between the nodes"; [`fourier_sum_pole`]).
+/// The node pairs and weights of the orders `m >= 1` near the pole (module
+/// doc, "Between the nodes"), and `r` of [`fourier_sum_pole`].
 #[derive(Clone, Copy, Debug)]
 struct PoleCorners {
-    pairs: [usize; 4],
-    weights: [f64; 4],
-    r: [f64; 4],
+    pairs: [usize; 2],
+    weights: [f64; 2],
+    r: f64,
 }
 
 /// The orders `m >= 1` when either direction is in the last interval of
 /// nodes (between the node before `mu = 1` and `mu = 1`), or `None`. On the
-/// sphere a smooth `f` has Fourier coefficients `c_m = sin^m theta h_m`
-/// with `h_m` smooth in `theta^2`, hence in `mu`, and the table's orders
-/// `m >= 1` vanish at the node `mu = 1`; linear weights in `mu` across the
-/// last interval would make every order fall like `1 - mu ~ theta^2 / 2`,
-/// halving order 1 in the middle of it. There `h_m` is extrapolated
-/// linearly in `mu` from the two nodes before `mu = 1`, `n - 2` and `n - 3`:
-/// the orders `m >= 1` are those of node `n - 2` with weight
-/// `(1 + lambda) rho^m` and of node `n - 3` with weight `-lambda rho'^m`,
-/// `rho = sin theta / sin theta_{n-2}`, `rho' = sin theta / sin theta_{n-3}`,
-/// `lambda = (mu - mu_{n-2}) / (mu_{n-2} - mu_{n-3})` (0.43 at most with 32
-/// nodes). Carrying node `n - 2`'s orders with `rho^m` alone (until
-/// 2026-12-05) held `h_m` constant across the interval: for a lobe about 13
-/// degrees wide (thin tissue's transmission) 2.5% off at 2.5 degrees'
-/// incidence on a Gaussian model of it, 0.3% extrapolated. In the other
-/// direction's `mu` the orders are interpolated linearly (the triangles
-/// would take them from one node of it: 7% off at 2.5 degrees' incidence on
-/// a thin sheet). Symmetric in the two directions, so reciprocity is kept;
-/// order 0, hence the albedo, is the triangles'.
+/// sphere a smooth `f` has Fourier coefficients `c_m ~ sin^m theta` as
+/// `theta -> 0`, and the table's orders `m >= 1` vanish at the node `mu = 1`;
+/// linear weights in `mu` across the last interval would make every order
+/// fall like `1 - mu ~ theta^2 / 2`, halving order 1 in the middle of it.
+/// There the orders `m >= 1` of the node before it are carried with weight
+/// `rho^m`, `rho = sin theta / sin theta_{n-2}`, and interpolated linearly in
+/// the other direction's `mu` (the triangles would take them from one node
+/// of it: 7% off at 2.5 degrees' incidence on a thin sheet). Symmetric in
+/// the two directions, so reciprocity is kept; order 0, hence the albedo, is
+/// the triangles'.
 #[inline]
 fn pole_corners(mu: &[f64], wi: Place, wo: Place) -> Option<PoleCorners> {
     let n = mu.len();
     let last = n - 2;
-    let sin2 = |m: f64| (1.0 - m * m).max(0.0);
-    // Per direction: two (node, weight, r) terms.
-    let terms = |p: Place| -> ([usize; 2], [f64; 2], [f64; 2]) {
-        let (i, t) = p.at;
-        if i != last || t <= 0.0 {
-            return ([i, i + 1], [1.0 - t, t], [1.0, 1.0]);
-        }
-        let s2 = sin2(p.mu);
-        let rho = (s2 / sin2(mu[last])).sqrt().min(1.0);
-        if last == 0 {
-            return ([last, last], [1.0, 0.0], [rho, 0.0]);
-        }
-        let lambda = (p.mu - mu[last]) / (mu[last] - mu[last - 1]);
-        let rho_before = (s2 / sin2(mu[last - 1])).sqrt().min(1.0);
-        ([last, last - 1], [1.0 + lambda, -lambda], [rho, rho_before])
+    let rho = |p: Place| {
+        (p.at.0 == last && p.at.1 > 0.0).then(|| {
+            ((1.0 - p.mu * p.mu).max(0.0) / (1.0 - mu[last] * mu[last]))
+                .sqrt()
+                .min(1.0)
+        })
     };
-    let near = |p: Place| p.at.0 == last && p.at.1 > 0.0;
-    if !near(wi) && !near(wo) {
-        return None;
+    let ((j, tj), (o, to)) = (wi.at, wo.at);
+    let pair = |a: usize, b: usize| a * n + b;
+    match (rho(wi), rho(wo)) {
+        (None, None) => None,
+        (Some(ri), None) => Some(PoleCorners {
+            pairs: [pair(o, last), pair(o + 1, last)],
+            weights: [1.0 - to, to],
+            r: ri,
+        }),
+        (None, Some(ro)) => Some(PoleCorners {
+            pairs: [pair(last, j), pair(last, j + 1)],
+            weights: [1.0 - tj, tj],
+            r: ro,
+        }),
+        (Some(ri), Some(ro)) => Some(PoleCorners {
+            pairs: [pair(last, last), pair(last, last)],
+            weights: [1.0, 0.0],
+            r: ri * ro,
+        }),
     }
-    let (ni, wgt_i, ri) = terms(wi);
-    let (no, wgt_o, ro) = terms(wo);
-    let mut pole = PoleCorners {
-        pairs: [0; 4],
-        weights: [0.0; 4],
-        r: [0.0; 4],
-    };
-    for a in 0..2 {
-        for b in 0..2 {
-            let k = 2 * a + b;
-            pole.pairs[k] = no[a] * n + ni[b];
-            pole.weights[k] = wgt_o[a] * wgt_i[b];
-            pole.r[k] = ro[a] * ri[b];
-        }
-    }
-    Some(pole)
 }
 
 impl SlabBsdf {

@@ -50,7 +50,7 @@
 //! against the simulator: docs/accuracy_slab.md.
 //!
 //! **What is missing for issue 13.** Lobes narrower than the grid, whose
-//! peak values move by up to 9.8% when the nodes or the orders are doubled
+//! peak values move by up to 10.5% when the nodes or the orders are doubled
 //! (examples/convergence.rs): a coated front smoother than the grid (the
 //! glossy preset's Beckmann 0.04, devB's 0.08: the face's own reflection is
 //! analytic, but the light the coating/base boundary returns through it
@@ -60,9 +60,8 @@
 //! degrees within 0.001% of twice the orders, 4.6-6.2% before; at 85 R -85
 //! luster 2.2%, where the pairs beyond 85 degrees keep Fejer's weights); a thin sheet's unscattered transmission
 //! moves by up to 1.4% in its flanks (linear interpolation in `mu` across
-//! their bend) and by 2.1% when lit within the last interval of nodes
-//! (4.85 degrees from the normal; 3.6% before the orders `m >= 1` there
-//! were extrapolated from two nodes, 2026-12-05; its peak, interpolated along the table's
+//! their bend) and by 3.6% when lit within the last interval of nodes
+//! (4.85 degrees from the normal; its peak, interpolated along the table's
 //! diagonal since 2026-12-05, by 0.15%); further analytic parts
 //! (unscattered transmission through rough faces, exact single scattering
 //! as its own term: the tables hold every scattering order, so `slab` has

@@ -687,27 +687,22 @@ fn bad_input_is_an_error() {
 }
 
 /// Near the normal (inside the last interval of nodes, `theta < 4.85`
-/// degrees with 32 nodes) the table's orders `m >= 1` follow `sin^m theta`
-/// times a factor extrapolated linearly in `mu` from the two nodes before
-/// the pole, as a smooth function's on the sphere do, interpolated in the
-/// other direction's `mu` (`pole_corners` in src/bsdf.rs). The transmission of a
+/// degrees with 32 nodes) the table's orders `m >= 1` follow `sin^m theta`,
+/// as a smooth function's on the sphere do, interpolated in the other
+/// direction's `mu` (`pole_corners` in src/bsdf.rs). The transmission of a
 /// thin sheet with unequal faces agrees with the same sheet on twice the
 /// nodes (whose last interval ends at 2.4 degrees), on both sides of the
 /// normal and both sides of incidence:
 /// - lit at 30 degrees, seen within 4.5 degrees of the normal: within 1.5%
-///   (measured 0.54%; 0.59% with the factor held at the node before the
-///   pole). Linear weights in `mu`, which make every order fall
+///   (measured 0.59%). Linear weights in `mu`, which make every order fall
 ///   like `theta^2` and so halve order 1 in the middle of the interval,
 ///   were 3.2% apart (and 8% for the accuracy tables' thin tissue at 2.5
 ///   degrees, of opposite signs either side of the normal);
-/// - lit at 2.5 degrees, seen 5 to 10 degrees off the normal: within 2.5%
-///   (measured 1.87%; 2.84% with the factor held at the node before the
-///   pole, until 2026-12-05, and 4.29% when the orders `m >= 1` came from
-///   the triangles' one node of `mu_o` in the column before the pole). What
-///   is left is the linear interpolation of order 0 in `mu_o` across the
-///   lobe's bend (the same sheet lit at the normal, where only order 0
-///   counts, is 1.2% from twice the nodes seen 12-16 degrees off it;
-///   `examples/convergence_causes.rs`): 128 nodes agree with 64 within 0.6%.
+/// - lit at 2.5 degrees, seen 5 to 10 degrees off the normal: within 3.5%
+///   (measured 2.84%; 4.29% when the orders `m >= 1` came from the
+///   triangles' one node of `mu_o` in the column before the pole). What is
+///   left is the 32 nodes' resolution of a lobe a few degrees wide there:
+///   128 nodes agree with 64 within 0.6%.
 #[test]
 fn transmission_near_the_normal_converges() {
     let p = cases().into_iter().find(|(n, _)| *n == "thin-tissue").unwrap().1;
@@ -741,7 +736,7 @@ fn transmission_near_the_normal_converges() {
             let e = (x / y - 1.0).abs();
             worst_in = worst_in.max(e);
             assert!(
-                e < 0.025,
+                e < 0.035,
                 "side {side}, lit at 2.5, theta_o {t}: {x} with 32 nodes, {y} with 64"
             );
         }
