@@ -454,6 +454,9 @@ pub struct SlabBsdf {
     /// Per side and node: the factors that balance the interpolated tables
     /// ([`balance_interpolation`]).
     balance: [Vec<Rgb>; 2],
+    /// Per `[transmit][side]` and node: the factors that scale reflection
+    /// and transmission apart before the balance ([`split_balance`]).
+    split: [[Vec<Rgb>; 2]; 2],
     /// Per rough face and node interval: the analytic lobe's albedo
     /// ([`face_albedo`] at the nodes, [`cubic_at`] between them) as a cubic
     /// in the interval's fraction ([`interval_cubics`]; empty for a smooth face).
@@ -715,8 +718,10 @@ fn interpolant_weights(mu: &[f64], g: &[f64]) -> Vec<f64> {
 /// c_0[o][j]`, the albedo the solver conserves. The factor of a node pair is
 /// `x[exit side][o] x[side][j]`, symmetric in the pair and its reciprocal, so
 /// reciprocity is kept exactly; `x` is found by the symmetric Sinkhorn
-/// iteration `x_j <- x_j sqrt(target_j / current_j)`. `direct` (a part of
-/// `table`) is scaled by the same factors. Returns `x` per side and node.
+/// iteration `x_j <- x_j sqrt(target_j / current_j)`, after reflection
+/// and transmission were scaled apart ([`split_balance`]). `direct` (a part
+/// of `table`) is scaled by the same factors. Returns `x` per side and
+/// node, and the split's factors per `[transmit][side]` and node.
 // Side, node and channel index several tables at once.
 #[allow(clippy::needless_range_loop)]
 fn balance_interpolation(
@@ -727,13 +732,14 @@ fn balance_interpolation(
     cross: &[Vec<f64>; 2],
     shape: &[[Vec<f64>; 3]; 2],
     orders: usize,
-) -> [Vec<Rgb>; 2] {
+) -> ([Vec<Rgb>; 2], [[Vec<Rgb>; 2]; 2]) {
     let n = mu.len();
     let q: Vec<f64> = (0..n).map(|o| 2.0 * PI * w[o] * mu[o]).collect();
     let c0 = |tab: &[[Vec<Rgb>; 2]; 2], s: usize, t: usize, o: usize, j: usize, c: usize| {
         tab[s][t][(o * n + j) * orders].0[c]
     };
     let mut x = vec![[[1.0f64; 3]; 2]; n];
+    let mut split: [[Vec<Rgb>; 2]; 2] = std::array::from_fn(|_| std::array::from_fn(|_| vec![Rgb::splat(1.0); n]));
     for c in 0..3 {
         let wi = [
             interpolant_weights(mu, &shape[0][c]),
@@ -758,6 +764,14 @@ fn balance_interpolation(
                 })
             })
             .collect();
+        let f = split_balance(table, direct, n, &q, &wi, cross, orders, c);
+        for (t, per_side) in f.iter().enumerate() {
+            for (s, v) in per_side.iter().enumerate() {
+                for (j, x) in v.iter().enumerate() {
+                    split[t][s][j].0[c] = *x;
+                }
+            }
+        }
         for _sweep in 0..200 {
             let mut worst = 0.0f64;
             for s in 0..2 {
@@ -797,7 +811,106 @@ fn balance_interpolation(
             }
         }
     }
-    [0, 1].map(|s| x.iter().map(|xj| Rgb(xj[s])).collect())
+    ([0, 1].map(|s| x.iter().map(|xj| Rgb(xj[s])).collect()), split)
+}
+
+/// Sweeps of [`split_balance`]: its reflection converges in tens; its
+/// transmission cannot meet both sides' targets at once (below), and the
+/// compromise moves by less than 1e-6 after 50.
+const SPLIT_SWEEPS: usize = 100;
+
+/// The first step of [`balance_interpolation`] for channel `c`: reflection
+/// and transmission scaled apart, so that the interpolant's split between
+/// them is the quadrature's before the common factors make the sum exact.
+/// A lobe narrower than the nodes (the light a thin sheet with faces
+/// smoother than the grid sends straight through or mirrors back from its
+/// far face near the normal) sits on one node pair, where the interpolant
+/// integrates it with its hat's weight, not the quadrature's (at the pole,
+/// `mu = 1`, the hat's half interval against Radau's small end weight);
+/// with one factor per node for both, the transmission's excess came out
+/// of the reflection: a thin sheet with GGX 0.1 faces reflected 0.235 at
+/// normal incidence where the solver (and the simulator) give 0.247 (0.250),
+/// until 2026-12-05. Reflection from side `s`, pair `(o, j)`, is scaled by
+/// `a[s][o] a[s][j]`, transmission from `s` by `b[1 - s][o] b[s][j]`:
+/// symmetric in a pair and its reciprocal. The reflection's targets are
+/// met (symmetric Sinkhorn); the transmission's are met only as well as
+/// their weighted sums from the two sides agree (the interpolant's and the
+/// quadrature's weights differ), which the common factors then close.
+#[allow(clippy::too_many_arguments)]
+fn split_balance(
+    table: &mut [[Vec<Rgb>; 2]; 2],
+    direct: &mut [[Vec<Rgb>; 2]; 2],
+    n: usize,
+    q: &[f64],
+    wi: &[Vec<f64>; 2],
+    cross: &[Vec<f64>; 2],
+    orders: usize,
+    c: usize,
+) -> [[Vec<f64>; 2]; 2] {
+    let c0 = |tab: &[[Vec<Rgb>; 2]; 2], s: usize, t: usize, o: usize, j: usize| tab[s][t][(o * n + j) * orders].0[c];
+    let unexit = |tab: &[[Vec<Rgb>; 2]; 2], s: usize, t: usize, o: usize, j: usize| {
+        let e = cross[if t == 1 { 1 - s } else { s }][o];
+        if e > 0.0 {
+            c0(tab, s, t, o, j) / e
+        } else {
+            0.0
+        }
+    };
+    // target[t][s][j]: the quadrature's reflection (t = 0) or transmission
+    // (t = 1) for light from side s at node j.
+    let target: Vec<Vec<Vec<f64>>> = (0..2)
+        .map(|t| {
+            (0..2)
+                .map(|s| {
+                    (0..n)
+                        .map(|j| (0..n).map(|o| q[o] * unexit(table, s, t, o, j)).sum())
+                        .collect()
+                })
+                .collect()
+        })
+        .collect();
+    let mut f = [[vec![1.0f64; n], vec![1.0f64; n]], [vec![1.0f64; n], vec![1.0f64; n]]];
+    for _ in 0..SPLIT_SWEEPS {
+        for t in 0..2 {
+            let now: Vec<Vec<f64>> = (0..2)
+                .map(|s| {
+                    let exit = if t == 1 { 1 - s } else { s };
+                    (0..n)
+                        .map(|j| {
+                            f[t][s][j]
+                                * (0..n)
+                                    .map(|o| wi[exit][o] * c0(table, s, t, o, j) * f[t][exit][o])
+                                    .sum::<f64>()
+                        })
+                        .collect()
+                })
+                .collect();
+            for s in 0..2 {
+                for j in 0..n {
+                    let (tg, cur) = (target[t][s][j], now[s][j]);
+                    if tg > 0.0 && cur > 0.0 {
+                        f[t][s][j] *= (tg / cur).sqrt();
+                    }
+                }
+            }
+        }
+    }
+    for tab in [table, direct] {
+        for s in 0..2 {
+            for t in 0..2 {
+                let exit = if t == 1 { 1 - s } else { s };
+                for o in 0..n {
+                    for j in 0..n {
+                        let k = f[t][exit][o] * f[t][s][j];
+                        for v in &mut tab[s][t][(o * n + j) * orders..(o * n + j + 1) * orders] {
+                            v.0[c] *= k;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    f
 }
 
 /// Passes of [`ridge_ratios`] and rebalancing in the build. The
@@ -960,6 +1073,114 @@ fn negative_mass(v: &[Rgb], k: usize) -> f64 {
 /// `eval`'s clamp adds, well below the 2e-5 the interpolated tables are
 /// balanced to.
 const RING_TOLERANCE: f64 = 1e-5;
+
+/// How much energy a node pair's series may add through `eval`'s clamp
+/// before [`fejer_where_ringing`] gives it Fejer's weights: the mean over
+/// azimuth of its negative part ([`negative_mass`]) times the quadrature
+/// weight of its exit node, `2 pi w_o mu_o`, against the albedo of its
+/// incident node in the same table (the sum of such terms over the exit
+/// nodes is what the clamp adds to that albedo: at most 32 times this,
+/// 3.2e-5, with 32 nodes). Relative to the pair's own mean (as
+/// [`RING_TOLERANCE`] is for the walk's orders, which only a pair's own
+/// light can make ring) it caught pairs whose mean is nil to rounding (the
+/// unscattered table's reflection) on most sheets; relative to the largest
+/// value of the column (1e-4 of it, tried) it let the flanks of a lobe on
+/// one node pair ring, 2.7e-3 of energy added between the nodes for thin
+/// tissue with GGX 0.01 faces. So measured, of the accuracy tables' sheets
+/// only the glossy preset has such pairs (about its coated front's
+/// specular reflection).
+const RING_ENERGY_TOLERANCE: f64 = 1e-6;
+
+/// Gives Fejer's weights `1 - m / M` (`M` = `solved`, the solution's
+/// orders; the walk's orders past them, where a reflection pair has them,
+/// are dropped there: the pair's ringing is in the solution's orders, which
+/// the walk's fallback to Fejer's weights, [`RING_TOLERANCE`], does not
+/// see) to every
+/// node pair, in `table` and in its part `direct`, whose series in either
+/// rings below zero by more than [`RING_ENERGY_TOLERANCE`] in any of the
+/// first `ks` channels, and to its reciprocal pair (reflection `(o, j)` and
+/// `(j, o)` from the same side, transmission `(o, j)` from one side and
+/// `(j, o)` from the other). `eval` clamps the sum at 0, which adds the
+/// negative part's energy; Fejer's sum of a non-negative function's orders
+/// is non-negative, and order 0 (the albedo, the balance) is kept. Such
+/// pairs hold a lobe narrower in azimuth than the orders resolve: a thin
+/// sheet's unscattered light through faces smoother than GGX 0.05 or so,
+/// seen away from the normal, whose clamped sum reflected and transmitted
+/// up to 1.17 times the light it received until 2026-12-05 (thin tissue,
+/// `examples/smooth_faces.rs`, with GGX 0.001 faces lit at 30 degrees; now
+/// 0.965, the simulator 0.965). The lobe is widened in azimuth to the
+/// orders' resolution (Fejer's kernel, about `2 pi / M` wide).
+fn fejer_where_ringing(
+    table: &mut [[Vec<Rgb>; 2]; 2],
+    direct: &mut [[Vec<Rgb>; 2]; 2],
+    q: &[f64],
+    orders: [[usize; 2]; 2],
+    solved: usize,
+    ks: usize,
+) {
+    let n = q.len();
+    // Per side, transmission and incident node: the table's albedo.
+    let albedo: Vec<Vec<Vec<Rgb>>> = (0..2)
+        .map(|s| {
+            (0..2)
+                .map(|t| {
+                    let len = orders[s][t];
+                    (0..n)
+                        .map(|j| {
+                            (0..n).fold(Rgb::ZERO, |a, o| {
+                                let v = table[s][t][(o * n + j) * len];
+                                Rgb(std::array::from_fn(|k| a.0[k] + q[o] * v.0[k].abs()))
+                            })
+                        })
+                        .collect()
+                })
+                .collect()
+        })
+        .collect();
+    let rings = |tab: &[[Vec<Rgb>; 2]; 2], s: usize, t: usize, p: usize| -> bool {
+        let len = orders[s][t];
+        let v = &tab[s][t][p * len..(p + 1) * len];
+        let (o, j) = (p / n, p % n);
+        (0..ks).any(|k| q[o] * negative_mass(v, k) > RING_ENERGY_TOLERANCE * albedo[s][t][j].0[k])
+    };
+    for s in 0..2 {
+        for t in 0..2 {
+            // Each unordered pair once: the reciprocal of transmission from
+            // side 1 is transmission from side 0.
+            if t == 1 && s == 1 {
+                continue;
+            }
+            let len = orders[s][t];
+            let (rs, rt) = if t == 1 { (1 - s, 1) } else { (s, 0) };
+            let flagged: Vec<(usize, usize)> = (0..n * n)
+                .into_par_iter()
+                .filter_map(|p| {
+                    let (o, j) = (p / n, p % n);
+                    if t == 0 && o > j {
+                        return None;
+                    }
+                    let q = j * n + o;
+                    let any = [&*table, &*direct]
+                        .iter()
+                        .any(|tab| rings(tab, s, t, p) || rings(tab, rs, rt, q));
+                    any.then_some((o, j))
+                })
+                .collect();
+            for (o, j) in flagged {
+                for tab in [&mut *table, &mut *direct] {
+                    for (ss, tt, pp) in [(s, t, o * n + j), (rs, rt, j * n + o)] {
+                        let l = orders[ss][tt];
+                        debug_assert_eq!(l, len);
+                        for (m, v) in tab[ss][tt][pp * l..(pp + 1) * l].iter_mut().enumerate() {
+                            let w = (1.0 - m as f64 / solved as f64).max(0.0);
+                            *v = v.map(|x| x * w);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
 
 /// The Fourier series `sum_m s_m cos(m phi)` (`c = cos phi`) of the three
 /// node pairs `pairs` of a table `tab` with `K` channels, weighted by
@@ -1406,7 +1627,8 @@ impl SlabBsdf {
         let linear_shape = [Side::Front, Side::Back].map(|side| crossing_shape(&g.mu, |m| face_r_at(side, m)));
         let mut shape = linear_shape.clone().map(|g| [g.clone(), g.clone(), g]);
         let unbalanced = (table.clone(), direct.clone());
-        let mut balance = balance_interpolation(&mut table, &mut direct, &g.mu, &g.w, &cross, &shape, m_solved);
+        let (mut balance, mut split) =
+            balance_interpolation(&mut table, &mut direct, &g.mu, &g.w, &cross, &shape, m_solved);
         // The triangles' albedo between the nodes of `mu_i` (ridge_ratios),
         // folded into the crossing shapes, which changes the exit weights of
         // the balance: the solution rebalanced, a few passes.
@@ -1420,10 +1642,10 @@ impl SlabBsdf {
                 }
             }
             (table, direct) = unbalanced.clone();
-            balance = balance_interpolation(&mut table, &mut direct, &g.mu, &g.w, &cross, &shape, m_solved);
+            (balance, split) = balance_interpolation(&mut table, &mut direct, &g.mu, &g.w, &cross, &shape, m_solved);
         }
         // The walk's orders past the solution's, balanced as the rest of
-        // their pairs (factors x_o x_j on the lit side), joined to the
+        // their pairs (factors x_o x_j and the reflection's split factors on the lit side), joined to the
         // reflection tables.
         let mut orders = [[m_solved; 2]; 2];
         if extra_len > 0 {
@@ -1432,7 +1654,12 @@ impl SlabBsdf {
                     (0..n * n)
                         .flat_map(|p| {
                             let (o, j) = (p / n, p % n);
-                            let f = balance[side][o].zip(balance[side][j], |a, b| a * b);
+                            let f = Rgb(std::array::from_fn(|c| {
+                                balance[side][o].0[c]
+                                    * balance[side][j].0[c]
+                                    * split[0][side][o].0[c]
+                                    * split[0][side][j].0[c]
+                            }));
                             tab[p * m_solved..(p + 1) * m_solved].iter().copied().chain(
                                 extra[side][p * extra_len..(p + 1) * extra_len]
                                     .iter()
@@ -1446,6 +1673,8 @@ impl SlabBsdf {
                 orders[side][0] = m_count;
             }
         }
+        let q: Vec<f64> = (0..n).map(|o| 2.0 * PI * g.w[o] * g.mu[o]).collect();
+        fejer_where_ringing(&mut table, &mut direct, &q, orders, m_solved, if grey { 1 } else { 3 });
         let (table, direct) = (
             Tables::truncate(table, n, orders, grey),
             Tables::truncate(direct, n, orders, grey),
@@ -1479,6 +1708,7 @@ impl SlabBsdf {
             crossing: cross,
             shape,
             balance,
+            split,
             face_polys,
         };
         for side in Side::BOTH {
@@ -1613,6 +1843,17 @@ impl SlabBsdf {
         &self.balance[side as usize]
     }
 
+    /// The factors `y_j` (per channel) by which reflection (`transmit =
+    /// false`) or transmission of light arriving or leaving at node `j` on
+    /// `side` was scaled before the balance, so that the interpolated
+    /// table splits its albedo between the two as the solver does (module
+    /// doc, "Energy"; `split_balance`): a node pair `(o, j)` of light from
+    /// `side` is scaled by `y_o y_j` with `y_o` of the exit side, and then by
+    /// [`SlabBsdf::balance_factors`].
+    pub fn split_factors(&self, transmit: bool, side: Side) -> &[Rgb] {
+        &self.split[usize::from(transmit)][side as usize]
+    }
+
     /// The solved outside nodes (ascending, the last `mu = 1`).
     pub fn nodes(&self) -> &[f64] {
         &self.mu
@@ -1651,7 +1892,12 @@ impl SlabBsdf {
             .map(|c| (c.cdf.len() + c.prob.len() + c.edge.len()) * 8 + c.guide.len() * 4)
             .sum();
         let shapes: usize = self.shape.iter().flatten().map(|g| g.len() * 8).sum();
-        let balance: usize = self.balance.iter().map(|x| x.len() * std::mem::size_of::<Rgb>()).sum();
+        let balance: usize = self
+            .balance
+            .iter()
+            .chain(self.split.iter().flatten())
+            .map(|x| x.len() * std::mem::size_of::<Rgb>())
+            .sum();
         let face_polys: usize = self
             .face_polys
             .iter()

@@ -71,11 +71,18 @@
 //! points per axis). As the phase function's ([`crate::phase`]), the
 //! matrices are therefore rescaled symmetrically, `K[o][j] s_o s_j` in every
 //! order and block (outside and inside nodes have their own factors; a
-//! symmetric Sinkhorn iteration), so that every node's `R + T` is core's
-//! exactly: the symmetric scaling keeps reciprocity, and the factors
-//! ([`ProjectedFace::scale`]) show how far the raw projection was. The split
-//! between `R` and `T` keeps an error (measured in tests/rough_face.rs: up to
-//! 1e-3 from outside and 5e-3 from inside at 32 nodes). For Beckmann, core's
+//! symmetric Sinkhorn iteration), so that every outside node's `R + T` and
+//! every inside node's `T` is core's exactly, and the reflection from
+//! inside, with factors of its own, so that every inside node's `R` is
+//! core's too: the symmetric scalings keep reciprocity, and the factors
+//! ([`ProjectedFace::scale`]) show how far the raw projection was. From
+//! outside the split between `R` and `T` keeps an error (tests/rough_face.rs:
+//! up to 2.2e-3 at 32 nodes), which the `slab` model does not use: it
+//! replaces the lit face's reflection by the analytic lobe and what crosses
+//! the face is rescaled to the transmittance that lobe leaves. Until
+//! 2026-12-05 the split from inside kept an error too (5e-3 for GGX 0.5,
+//! and for faces smoother than the nodes most of their reflection:
+//! `normalise_face`). For Beckmann, core's
 //! albedo uses the exact Smith `G1` of the incident direction where
 //! `eval_mode` uses Walter's rational approximation (below 0.35% apart,
 //! `paperbsdf_core::microsurface`); the normalisation follows the former.
@@ -517,22 +524,55 @@ fn walter_projection(bd: &RoughDielectric, outside: &Grid, inside: &Grid, orders
         .collect()
 }
 
-/// Scales every order of Walter's projected face `l` by `s_o s_j` so that the
-/// order-0 albedo `R + T` of every node matches core's quadrature of the face
-/// (module doc); returns the factors (outside nodes, then inside nodes).
+/// Scales every order of Walter's projected face `l` so that the order-0
+/// albedos of every node match core's quadrature of the face (module doc):
+/// from outside `R + T` (factors `s_o s_j` on `r_top`, `s_o s_j` on the
+/// transmission blocks, outside and inside factors alike); from inside the
+/// transmittance `T` (the same `s` on `t_up`) and, with factors of its own
+/// (`a_o a_j` on `r_bot`), the reflectance `R`. Returns `s` (outside
+/// nodes, then inside nodes).
+///
+/// From inside the split matters as well as the sum: a lobe narrower than
+/// the nodes is sampled at its peak on the diagonal of both blocks, with
+/// Jacobians (reflection `1 / (4 |h.w|)`, refraction `eta^2 |h.w| / (...)^2`)
+/// that the nodes' weights do not balance, and a single factor per node
+/// moved the reflection into the transmission: GGX m = 0.01 kept 0.2% of
+/// the 4% Fresnel reflection near the normal (0.05: half; 0.3: within
+/// 5e-3), so a thin sheet with faces smoother than 0.1 reflected up to 0.04
+/// too little at normal incidence (thin tissue at m = 0.01: 0.205 against
+/// the simulator's 0.244) until 2026-12-05. From outside only the sum is
+/// kept: `r_top` takes the rest of the split, and the `slab` model replaces
+/// the lit face's `r_top` by the analytic lobe and rescales what crosses it
+/// to the transmittance that lobe leaves (crates/slab/src/bsdf.rs). Light
+/// reaches `r_top` from nowhere else.
 fn normalise_face(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut [Layer]) -> Result<Vec<f64>, SlabError> {
-    let target = |g: &Grid, side: f64| -> Vec<f64> {
+    let target = |g: &Grid, side: f64| -> Vec<(f64, f64)> {
         g.mu.par_iter()
-            .map(|&mu| {
-                let (r, t) = directional_albedo_n(bd, dir_at_mu(mu, side), ALBEDO_POINTS);
-                r + t
-            })
+            .map(|&mu| directional_albedo_n(bd, dir_at_mu(mu, side), ALBEDO_POINTS))
             .collect()
     };
-    let (t_out, t_in) = (target(outside, 1.0), target(inside, -1.0));
+    let t_out: Vec<f64> = target(outside, 1.0).iter().map(|(r, t)| r + t).collect();
+    let (mut r_in, mut t_in): (Vec<f64>, Vec<f64>) = target(inside, -1.0).into_iter().unzip();
     let (no, ni) = (outside.len(), inside.len());
+    // A block that the grid leaves empty at an inside node (the rough face's
+    // transmission from a node a hair's breadth from grazing, which core's
+    // quadrature finds and the nodes outside miss) cannot be scaled to its
+    // target: the other block takes that share, as the sum's single factor did.
+    for j in 0..ni {
+        let raw_t = column_albedo(&l[0].t_up, outside, inside, j);
+        let raw_r = column_albedo(&l[0].r_bot, inside, inside, j);
+        if raw_t <= 0.0 {
+            r_in[j] += std::mem::take(&mut t_in[j]);
+        } else if raw_r <= 0.0 {
+            t_in[j] += std::mem::take(&mut r_in[j]);
+        }
+    }
     let (mut s_out, mut s_in) = (vec![1.0; no], vec![1.0; ni]);
+    let mut a_in = vec![1.0; ni];
     let l0 = &l[0];
+    // Below this a node's target is nil (total internal reflection, or no
+    // reflection at all): its raw column must be too, and its factor stays.
+    let nil = 1e-14;
     let mut converged = false;
     for _ in 0..MAX_NORMALISATION_ITERATIONS {
         let col = |k: &DMatrix<f64>, to: &Grid, s_to: &[f64], j: usize| -> f64 {
@@ -540,33 +580,35 @@ fn normalise_face(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut [
                 .map(|o| to.w[o] * to.mu[o] * s_to[o] * k[(o, j)])
                 .sum::<f64>()
         };
-        let a_out: Vec<f64> = (0..no)
+        let now_out: Vec<f64> = (0..no)
             .map(|j| {
                 s_out[j] * (col(&l0.r_top, outside, &s_out, j) + col(&l0.t_down, inside, &s_in, j))
                     / (outside.w[j] * outside.mu[j])
             })
             .collect();
-        let a_in: Vec<f64> = (0..ni)
-            .map(|j| {
-                s_in[j] * (col(&l0.r_bot, inside, &s_in, j) + col(&l0.t_up, outside, &s_out, j))
-                    / (inside.w[j] * inside.mu[j])
-            })
+        let now_t_in: Vec<f64> = (0..ni)
+            .map(|j| s_in[j] * col(&l0.t_up, outside, &s_out, j) / (inside.w[j] * inside.mu[j]))
+            .collect();
+        let now_r_in: Vec<f64> = (0..ni)
+            .map(|j| a_in[j] * col(&l0.r_bot, inside, &a_in, j) / (inside.w[j] * inside.mu[j]))
             .collect();
         let mut worst: f64 = 0.0;
-        for (s, (a, t)) in s_out.iter_mut().zip(a_out.iter().zip(&t_out)) {
-            if !(*a > 0.0 && a.is_finite()) {
-                return Err(unresolved());
+        let mut step = |s: &mut [f64], now: &[f64], want: &[f64]| -> Result<(), SlabError> {
+            for (s, (a, t)) in s.iter_mut().zip(now.iter().zip(want)) {
+                if *t <= nil && *a <= nil {
+                    continue;
+                }
+                if !(*a > 0.0 && a.is_finite()) {
+                    return Err(unresolved());
+                }
+                worst = worst.max((a / t.max(nil) - 1.0).abs());
+                *s *= (t.max(nil) / a).sqrt();
             }
-            worst = worst.max((a / t - 1.0).abs());
-            *s *= (t / a).sqrt();
-        }
-        for (s, (a, t)) in s_in.iter_mut().zip(a_in.iter().zip(&t_in)) {
-            if !(*a > 0.0 && a.is_finite()) {
-                return Err(unresolved());
-            }
-            worst = worst.max((a / t - 1.0).abs());
-            *s *= (t / a).sqrt();
-        }
+            Ok(())
+        };
+        step(&mut s_out, &now_out, &t_out)?;
+        step(&mut s_in, &now_t_in, &t_in)?;
+        step(&mut a_in, &now_r_in, &r_in)?;
         if worst < 1e-12 {
             converged = true;
             break;
@@ -578,7 +620,7 @@ fn normalise_face(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut [
     for layer in l.iter_mut() {
         scale_rows_cols(&mut layer.r_top, &s_out, &s_out);
         scale_rows_cols(&mut layer.t_down, &s_in, &s_out);
-        scale_rows_cols(&mut layer.r_bot, &s_in, &s_in);
+        scale_rows_cols(&mut layer.r_bot, &a_in, &a_in);
         scale_rows_cols(&mut layer.t_up, &s_out, &s_in);
     }
     Ok(s_out.into_iter().chain(s_in).collect())

@@ -17,11 +17,18 @@
 //! nodes (16 in the cone of total internal reflection), eta = 1.5, largest
 //! over the nodes: the raw projection's `R` and `T` are within 3.0e-2 of
 //! core's (GGX m = 0.15 at normal incidence, the narrowest lobe; 7e-3 for
-//! m = 0.3, 1.2e-2 for 0.5); normalised to core's `R + T` (the solver's
-//! default) the split is within 1.0e-3 from outside and 5.1e-3 from inside
-//! (GGX m = 0.5; 2.1e-3 at m = 0.15; GGX m = 0.3: 9.7e-4, 3.3e-3; Beckmann
-//! m = 0.15: 1.4e-4, 3.2e-3, m = 0.3: 1.1e-4, 1.8e-3). Asked: raw 4e-2,
-//! normalised 2e-3 from outside and 6e-3 from inside.
+//! m = 0.3, 1.2e-2 for 0.5). Normalised (the solver's default), from
+//! inside `R` and `T` are core's each, within 1e-12 (measured 8.9e-13), and
+//! from outside their sum is, with the split within 2.2e-3 (GGX m = 0.5;
+//! 1.3e-3 at m = 0.15). Until 2026-12-05 one factor per node made only the
+//! sums core's, with the split within 1.0e-3 from outside and 5.1e-3 from
+//! inside (GGX m = 0.5) and, for faces smoother than the nodes, far worse
+//! (GGX m = 0.01 kept 0.2% of its 4% reflection from inside near the
+//! normal); the split from outside takes the rest now, which the `slab`
+//! model does not use: it replaces the lit face's reflection by the
+//! analytic lobe and rescales what crosses the face to the transmittance
+//! that lobe leaves (crates/slab/src/interface.rs, `normalise_face`).
+//! Asked: raw 4e-2; normalised 1e-9 from inside and 3e-3 from outside.
 //!
 //! With `"multiple"` faces every node's `R + T` is 1 within 1e-12 (the
 //! normalisation's tolerance; measured 9e-13), far inside issue 14's 2e-3,
@@ -101,7 +108,7 @@ fn single_face_albedo_matches_cores_quadrature() {
             "{dist:?} m = {m}: largest |albedo - core|, raw projection: from outside {r_out:.1e}, from inside {r_in:.1e}; normalised (largest |s - 1| {s_dev:.1e}): {e_out:.1e}, {e_in:.1e}"
         );
         assert!(r_out < 0.04 && r_in < 0.04, "{dist:?} m={m}: {r_out} {r_in}");
-        assert!(e_out < 2e-3 && e_in < 6e-3, "{dist:?} m={m}: {e_out} {e_in}");
+        assert!(e_out < 3e-3 && e_in < 1e-9, "{dist:?} m={m}: {e_out} {e_in}");
     }
 }
 

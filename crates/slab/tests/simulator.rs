@@ -14,8 +14,8 @@
 //! **Tolerance**: `3 sigma + 3e-3` per total, sigma the simulator's standard
 //! error. The 3e-3 holds the solver's discretisation (32 -> 64 nodes moves
 //! these totals by at most 5.6e-4, tests/rough_convergence.rs), the split of
-//! each face's R and T (within 1e-3 from outside and 5e-3 from inside of
-//! core's quadrature, tests/rough_face.rs) and, for `"multiple"`, the
+//! each face's R and T (from outside within 2.2e-3 of core's quadrature,
+//! tests/rough_face.rs; from inside exact since 2026-12-05, 5e-3 before) and, for `"multiple"`, the
 //! discretisation of the faces' microsurface walk (the simulator's walk,
 //! Heitz et al. 2016, solved on the grids: `paperbsdf_slab::face_walk`;
 //! until 2026-12-04 the solver's face was core's separable compensation

@@ -16,6 +16,8 @@
 #[path = "../../core/tests/support/chi2.rs"]
 mod chi2;
 
+mod support;
+
 use paperbsdf_core::bsdf::albedo_from;
 use paperbsdf_core::geometry::spherical_direction;
 use paperbsdf_core::models::{Component, ComponentModel};
@@ -24,6 +26,7 @@ use paperbsdf_core::presets::preset;
 use paperbsdf_core::{Bsdf, Colour, DVec3, Distribution, FaceScattering, PaperBsdf, PaperParams};
 use paperbsdf_slab::{face_albedo, SlabBsdf, SlabOptions, SlabSpec};
 use std::f64::consts::PI;
+use support::grid_albedo;
 
 fn sheet(d: f64, sa: f64, ss: f64, faces: [(f64, f64, Distribution); 2], fs: FaceScattering) -> PaperParams {
     PaperParams {
@@ -229,48 +232,6 @@ fn energy_is_bounded() {
     }
 }
 
-/// `int eval(wi, wo) |cos wo| dwo` over both hemispheres by a deterministic
-/// rule: in `mu_o` Gauss-Legendre (`per` points) on each interval between the
-/// table's nodes and `mu_i` (the table's triangles are linear in `mu_o`
-/// there: their diagonal crosses the interval holding `mu_i` at `mu_o =
-/// mu_i`; times the crossing shapes, linear on finer steps, the rule is
-/// nearly exact) and on `[0, mu_0]`, each interval also split
-/// in `split` equal parts (for the analytic face's lobe); in azimuth the
-/// midpoint rule with `n_phi` points, exact for the table's Fourier sum when
-/// `n_phi` exceeds its highest order (`sum_k cos(m phi_k)` vanishes unless
-/// `n_phi` divides `m`: with 96 points the walk's order 96, of the default
-/// 256 [`SlabOptions::walk_orders`], read as order 0, -6e-5 at 80 degrees).
-fn grid_albedo(f: impl Fn(DVec3) -> f64, nodes: &[f64], mu_i: f64, per: usize, split: usize, n_phi: usize) -> f64 {
-    let (x, w) = paperbsdf_core::quadrature::gauss_legendre_01(per);
-    let mut edges = vec![0.0];
-    edges.extend_from_slice(nodes);
-    if nodes.iter().all(|&m| (m - mu_i).abs() > 1e-12) && mu_i > nodes[0] && mu_i < 1.0 {
-        edges.push(mu_i);
-        edges.sort_by(f64::total_cmp);
-    }
-    let mut total = 0.0;
-    for side in [1.0, -1.0] {
-        for e in edges.windows(2) {
-            let h = (e[1] - e[0]) / split as f64;
-            for part in 0..split {
-                let a = e[0] + part as f64 * h;
-                for (xk, wk) in x.iter().zip(&w) {
-                    let mu = a + xk * h;
-                    let s = (1.0 - mu * mu).max(0.0).sqrt();
-                    let mut ring = 0.0;
-                    for k in 0..n_phi {
-                        let phi = (k as f64 + 0.5) / n_phi as f64 * 2.0 * PI;
-                        let wo = DVec3::new(s * phi.cos(), s * phi.sin(), side * mu);
-                        ring += f(wo);
-                    }
-                    total += wk * h * mu * ring * 2.0 * PI / n_phi as f64;
-                }
-            }
-        }
-    }
-    total
-}
-
 /// Non-absorbing sheets with energy-conserving faces (`face_scattering =
 /// "multiple"`) close: `R + T = 1 +- 1e-4`, by [`grid_albedo`]
 /// (deterministic: `albedo_from`'s quasi-random estimate carries a bias of
@@ -396,8 +357,9 @@ fn energy_closes_without_absorption() {
 
 /// At the nodes, in transmission, `eval` is the solution's BSDF with the
 /// faces' crossings rescaled (`crossing_factors`, which must stay within 3%
-/// of 1: the projected faces' R/T split is good to about 1e-3 in albedo) and
-/// balanced (`balance_factors`, within 2%; the crossing shapes are 1 at the nodes).
+/// of 1: the projected faces' R/T split is good to about 1e-3 in albedo),
+/// split (`split_factors`) and balanced (`balance_factors`; the two within
+/// 2%; the crossing shapes are 1 at the nodes).
 #[test]
 fn eval_at_the_nodes_is_the_solution() {
     let p = preset("luster").unwrap();
@@ -422,6 +384,11 @@ fn eval_at_the_nodes_is_the_solution() {
         for x in b.balance_factors(side) {
             assert!((x.0[0] - 1.0).abs() < 0.02, "balance factor {}", x.0[0]);
         }
+        for transmit in [false, true] {
+            for y in b.split_factors(transmit, side) {
+                assert!((y.0[0] - 1.0).abs() < 0.02, "split factor {}", y.0[0]);
+            }
+        }
     }
     for &j in &[3usize, 12, 20, n - 2] {
         for &o in &[5usize, 17, 25] {
@@ -438,6 +405,8 @@ fn eval_at_the_nodes_is_the_solution() {
                 let (front, back) = (paperbsdf_core::paper::Side::Front, paperbsdf_core::paper::Side::Back);
                 let s = b.crossing_factors(front)[j]
                     * b.crossing_factors(back)[o]
+                    * b.split_factors(true, front)[j].0[0]
+                    * b.split_factors(true, back)[o].0[0]
                     * b.balance_factors(front)[j].0[0]
                     * b.balance_factors(back)[o].0[0];
                 let want = s * sol.bsdf_at_nodes(paperbsdf_slab::Side::Front, true, o, j, phi);
