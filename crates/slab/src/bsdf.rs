@@ -796,14 +796,30 @@ fn balance_interpolation(
             }
         }
     }
+    scale_pairs(table, direct, n, orders, |s, exit, o, j| {
+        Rgb(std::array::from_fn(|c| x[o][exit][c] * x[j][s][c]))
+    });
+    ([0, 1].map(|s| x.iter().map(|xj| Rgb(xj[s])).collect()), split)
+}
+
+/// Multiplies every order of the node pair `(o, j)` (`wo` at node `o` on
+/// side `exit`, `wi` at node `j` on side `s`) in `table` and its part
+/// `direct` by `factor(s, exit, o, j)`, per channel.
+fn scale_pairs(
+    table: &mut [[Vec<Rgb>; 2]; 2],
+    direct: &mut [[Vec<Rgb>; 2]; 2],
+    n: usize,
+    orders: usize,
+    factor: impl Fn(usize, usize, usize, usize) -> Rgb,
+) {
     for tab in [table, direct] {
-        for s in 0..2 {
-            for t in 0..2 {
+        for (s, per_side) in tab.iter_mut().enumerate() {
+            for (t, pairs) in per_side.iter_mut().enumerate() {
                 let exit = if t == 1 { 1 - s } else { s };
                 for o in 0..n {
                     for j in 0..n {
-                        let f = Rgb(std::array::from_fn(|c| x[o][exit][c] * x[j][s][c]));
-                        for v in &mut tab[s][t][(o * n + j) * orders..(o * n + j + 1) * orders] {
+                        let f = factor(s, exit, o, j);
+                        for v in &mut pairs[(o * n + j) * orders..(o * n + j + 1) * orders] {
                             *v = v.zip(f, |a, b| a * b);
                         }
                     }
@@ -811,7 +827,6 @@ fn balance_interpolation(
             }
         }
     }
-    ([0, 1].map(|s| x.iter().map(|xj| Rgb(xj[s])).collect()), split)
 }
 
 /// Sweeps of [`split_balance`]: its reflection converges in tens; its
@@ -895,21 +910,11 @@ fn split_balance(
             }
         }
     }
-    for tab in [table, direct] {
-        for s in 0..2 {
-            for t in 0..2 {
-                let exit = if t == 1 { 1 - s } else { s };
-                for o in 0..n {
-                    for j in 0..n {
-                        let k = f[t][exit][o] * f[t][s][j];
-                        for v in &mut tab[s][t][(o * n + j) * orders..(o * n + j + 1) * orders] {
-                            v.0[c] *= k;
-                        }
-                    }
-                }
-            }
-        }
-    }
+    scale_pairs(table, direct, n, orders, |s, exit, o, j| {
+        let t = usize::from(exit != s);
+        let k = f[t][exit][o] * f[t][s][j];
+        Rgb(std::array::from_fn(|ch| if ch == c { k } else { 1.0 }))
+    });
     f
 }
 
@@ -1080,25 +1085,24 @@ const RING_TOLERANCE: f64 = 1e-5;
 /// weight of its exit node, `2 pi w_o mu_o`, against the albedo of its
 /// incident node in the same table (the sum of such terms over the exit
 /// nodes is what the clamp adds to that albedo: at most 32 times this,
-/// 3.2e-5, with 32 nodes). Relative to the pair's own mean (as
+/// 3.2e-5, with 32 nodes). Relative to the pair's own mean instead (as
 /// [`RING_TOLERANCE`] is for the walk's orders, which only a pair's own
-/// light can make ring) it caught pairs whose mean is nil to rounding (the
-/// unscattered table's reflection) on most sheets; relative to the largest
-/// value of the column (1e-4 of it, tried) it let the flanks of a lobe on
-/// one node pair ring, 2.7e-3 of energy added between the nodes for thin
-/// tissue with GGX 0.01 faces. So measured, of the accuracy tables' sheets
-/// only the glossy preset has such pairs (about its coated front's
-/// specular reflection).
+/// light can make ring) it caught pairs of the unscattered part whose mean
+/// is nil to rounding on most sheets. So measured, none of the accuracy
+/// tables' sheets has such a pair (their largest clamped energy per node is
+/// 0 in the table); thin tissue with GGX 0.05 faces has 5, with GGX 0.01
+/// 160, with GGX 0.001 175 (of 4096: reflection and transmission, both
+/// sides), where the clamp added up to 0.26 of a node's albedo (GGX 0.01).
 const RING_ENERGY_TOLERANCE: f64 = 1e-6;
 
 /// Gives Fejer's weights `1 - m / M` (`M` = `solved`, the solution's
 /// orders; the walk's orders past them, where a reflection pair has them,
 /// are dropped there: the pair's ringing is in the solution's orders, which
 /// the walk's fallback to Fejer's weights, [`RING_TOLERANCE`], does not
-/// see) to every
-/// node pair, in `table` and in its part `direct`, whose series in either
-/// rings below zero by more than [`RING_ENERGY_TOLERANCE`] in any of the
-/// first `ks` channels, and to its reciprocal pair (reflection `(o, j)` and
+/// see) to every node pair whose series in `table` (what `eval` sums and
+/// clamps) rings below zero by more than [`RING_ENERGY_TOLERANCE`] in any of
+/// the first `ks` channels, and to its reciprocal pair, in `table` and in
+/// its part `direct` alike (reflection `(o, j)` and
 /// `(j, o)` from the same side, transmission `(o, j)` from one side and
 /// `(j, o)` from the other). `eval` clamps the sum at 0, which adds the
 /// negative part's energy; Fejer's sum of a non-negative function's orders
@@ -1160,10 +1164,7 @@ fn fejer_where_ringing(
                         return None;
                     }
                     let q = j * n + o;
-                    let any = [&*table, &*direct]
-                        .iter()
-                        .any(|tab| rings(tab, s, t, p) || rings(tab, rs, rt, q));
-                    any.then_some((o, j))
+                    (rings(table, s, t, p) || rings(table, rs, rt, q)).then_some((o, j))
                 })
                 .collect();
             for (o, j) in flagged {

@@ -73,11 +73,12 @@ fn dir(theta_deg: f64, side: f64) -> DVec3 {
 }
 
 /// Without absorption `R + T = 1` within 1e-4 (the energy test of
-/// tests/slab_bsdf.rs for paper-like faces), on nodes (0, 43.53, 75.31,
-/// 86.94 degrees) and between them, both sides. Measured before the fixes
-/// of the module doc: 1.17 at 30 degrees (GGX 0.001); with the split but a
-/// Fejer window over the walk's 256 orders where a pair rang, 9.2e-4 above
-/// 1 at 75.31 degrees (GGX 0.001: the solution's 48 orders still rang).
+/// tests/slab_bsdf.rs for paper-like faces; measured 1.1e-5), on nodes (0,
+/// 43.53, 75.31, 86.94 degrees) and between them, both sides. Measured
+/// before the fixes of the module doc: 1.17 at 30 degrees (GGX 0.001);
+/// with Fejer's window over the walk's 256 orders instead of the
+/// solution's 48 where a pair rang, 9.2e-4 above 1 at 75.31 degrees (GGX
+/// 0.001: the solution's orders still rang).
 #[test]
 fn faces_smoother_than_the_grid_conserve_energy() {
     use Distribution::{Beckmann, Ggx};
