@@ -60,7 +60,7 @@
 //! degrees within 0.001% of twice the orders, 4.6-6.2% before; at 85 R -85
 //! luster 2.2%, where the pairs beyond 85 degrees keep Fejer's weights); a thin sheet's unscattered transmission
 //! moves by up to 1.4% in its flanks (linear interpolation in `mu` across
-//! their bend) and by 3.6% when lit within the last interval of nodes
+//! their bend) and by 3.4% when lit within the last interval of nodes
 //! (4.85 degrees from the normal; its peak, interpolated along the table's
 //! diagonal since 2026-12-05, by 0.15%); further analytic parts
 //! (unscattered transmission through rough faces, exact single scattering
@@ -73,7 +73,7 @@
 //! split since 2026-12-05 (tests/smooth_faces.rs: a thin sheet with GGX
 //! 0.01 faces had reflected 0.205 instead of 0.244 at normal incidence, and
 //! R + T reached 1.17 at 30 degrees with GGX 0.001). Builds
-//! take 0.67 to 0.94 s for the presets (the coated glossy sheet the
+//! take 0.75 to 0.98 s for the presets (the coated glossy sheet the
 //! slowest). Near `eta_f = eta_b` from
 //! below (the base denser) the discretisation moves with the boundary's
 //! critical cosine, by `O(sqrt(eta_b - eta_f))` (8e-5 in the totals at a
