@@ -745,26 +745,29 @@ fn balance_interpolation(
             interpolant_weights(mu, &shape[0][c]),
             interpolant_weights(mu, &shape[1][c]),
         ];
-        let target: Vec<[f64; 2]> = (0..n)
-            .map(|j| {
-                [0, 1].map(|s| {
-                    (0..n)
-                        .map(|o| {
-                            let unexit = |t: usize| {
-                                let e = cross[if t == 1 { 1 - s } else { s }][o];
+        // target[t][s][j]: the quadrature's reflection (t = 0) or
+        // transmission (t = 1) for light from side s at node j, without the
+        // crossings' rescaling of the exit face.
+        let target: [[Vec<f64>; 2]; 2] = [0, 1].map(|t| {
+            [0, 1].map(|s| {
+                let exit = if t == 1 { 1 - s } else { s };
+                (0..n)
+                    .map(|j| {
+                        (0..n)
+                            .map(|o| {
+                                let e = cross[exit][o];
                                 if e > 0.0 {
-                                    c0(table, s, t, o, j, c) / e
+                                    q[o] * c0(table, s, t, o, j, c) / e
                                 } else {
                                     0.0
                                 }
-                            };
-                            q[o] * (unexit(0) + unexit(1))
-                        })
-                        .sum::<f64>()
-                })
+                            })
+                            .sum::<f64>()
+                    })
+                    .collect()
             })
-            .collect();
-        let f = split_balance(table, direct, n, &q, &wi, cross, orders, c);
+        });
+        let f = split_balance(table, direct, n, &target, &wi, orders, c);
         for (t, per_side) in f.iter().enumerate() {
             for (s, v) in per_side.iter().enumerate() {
                 for (j, x) in v.iter().enumerate() {
@@ -776,7 +779,7 @@ fn balance_interpolation(
             let mut worst = 0.0f64;
             for s in 0..2 {
                 for j in 0..n {
-                    let tg = target[j][s];
+                    let tg = target[0][s][j] + target[1][s][j];
                     let row: f64 = (0..n)
                         .map(|o| {
                             wi[s][o] * c0(table, s, 0, o, j, c) * x[o][s][c]
@@ -836,7 +839,9 @@ const SPLIT_SWEEPS: usize = 100;
 
 /// The first step of [`balance_interpolation`] for channel `c`: reflection
 /// and transmission scaled apart, so that the interpolant's split between
-/// them is the quadrature's before the common factors make the sum exact.
+/// them is the quadrature's (`target[transmit][side][node]`, from
+/// [`balance_interpolation`], `wi` the interpolant's weights per exit side)
+/// before the common factors make the sum exact.
 /// A lobe narrower than the nodes (the light a thin sheet with faces
 /// smoother than the grid sends straight through or mirrors back from its
 /// far face near the normal) sits on one node pair, where the interpolant
@@ -851,39 +856,16 @@ const SPLIT_SWEEPS: usize = 100;
 /// met (symmetric Sinkhorn); the transmission's are met only as well as
 /// their weighted sums from the two sides agree (the interpolant's and the
 /// quadrature's weights differ), which the common factors then close.
-#[allow(clippy::too_many_arguments)]
 fn split_balance(
     table: &mut [[Vec<Rgb>; 2]; 2],
     direct: &mut [[Vec<Rgb>; 2]; 2],
     n: usize,
-    q: &[f64],
+    target: &[[Vec<f64>; 2]; 2],
     wi: &[Vec<f64>; 2],
-    cross: &[Vec<f64>; 2],
     orders: usize,
     c: usize,
 ) -> [[Vec<f64>; 2]; 2] {
     let c0 = |tab: &[[Vec<Rgb>; 2]; 2], s: usize, t: usize, o: usize, j: usize| tab[s][t][(o * n + j) * orders].0[c];
-    let unexit = |tab: &[[Vec<Rgb>; 2]; 2], s: usize, t: usize, o: usize, j: usize| {
-        let e = cross[if t == 1 { 1 - s } else { s }][o];
-        if e > 0.0 {
-            c0(tab, s, t, o, j) / e
-        } else {
-            0.0
-        }
-    };
-    // target[t][s][j]: the quadrature's reflection (t = 0) or transmission
-    // (t = 1) for light from side s at node j.
-    let target: Vec<Vec<Vec<f64>>> = (0..2)
-        .map(|t| {
-            (0..2)
-                .map(|s| {
-                    (0..n)
-                        .map(|j| (0..n).map(|o| q[o] * unexit(table, s, t, o, j)).sum())
-                        .collect()
-                })
-                .collect()
-        })
-        .collect();
     let mut f = [[vec![1.0f64; n], vec![1.0f64; n]], [vec![1.0f64; n], vec![1.0f64; n]]];
     for _ in 0..SPLIT_SWEEPS {
         for t in 0..2 {
@@ -1110,10 +1092,11 @@ const RING_ENERGY_TOLERANCE: f64 = 1e-6;
 /// pairs hold a lobe narrower in azimuth than the orders resolve: a thin
 /// sheet's unscattered light through faces smoother than GGX 0.05 or so,
 /// seen away from the normal, whose clamped sum reflected and transmitted
-/// up to 1.17 times the light it received until 2026-12-05 (thin tissue,
-/// `examples/smooth_faces.rs`, with GGX 0.001 faces lit at 30 degrees; now
-/// 0.965, the simulator 0.965). The lobe is widened in azimuth to the
-/// orders' resolution (Fejer's kernel, about `2 pi / M` wide).
+/// up to 1.17 times the light it received until 2026-12-05 (thin tissue
+/// with GGX 0.001 faces lit at 30 degrees, `paperbsdf albedo --model
+/// slab`; tests/smooth_faces.rs checks such sheets' energy and their totals
+/// against the simulator). The lobe is widened in azimuth to the orders'
+/// resolution (Fejer's kernel, about `2 pi / M` wide).
 fn fejer_where_ringing(
     table: &mut [[Vec<Rgb>; 2]; 2],
     direct: &mut [[Vec<Rgb>; 2]; 2],
@@ -1154,7 +1137,6 @@ fn fejer_where_ringing(
             if t == 1 && s == 1 {
                 continue;
             }
-            let len = orders[s][t];
             let (rs, rt) = if t == 1 { (1 - s, 1) } else { (s, 0) };
             let flagged: Vec<(usize, usize)> = (0..n * n)
                 .into_par_iter()
@@ -1163,15 +1145,13 @@ fn fejer_where_ringing(
                     if t == 0 && o > j {
                         return None;
                     }
-                    let q = j * n + o;
-                    (rings(table, s, t, p) || rings(table, rs, rt, q)).then_some((o, j))
+                    (rings(table, s, t, p) || rings(table, rs, rt, j * n + o)).then_some((o, j))
                 })
                 .collect();
             for (o, j) in flagged {
                 for tab in [&mut *table, &mut *direct] {
                     for (ss, tt, pp) in [(s, t, o * n + j), (rs, rt, j * n + o)] {
                         let l = orders[ss][tt];
-                        debug_assert_eq!(l, len);
                         for (m, v) in tab[ss][tt][pp * l..(pp + 1) * l].iter_mut().enumerate() {
                             let w = (1.0 - m as f64 / solved as f64).max(0.0);
                             *v = v.map(|x| x * w);
