@@ -1070,7 +1070,8 @@ const RING_TOLERANCE: f64 = 1e-5;
 /// 3.2e-5, with 32 nodes). Relative to the pair's own mean instead (as
 /// [`RING_TOLERANCE`] is for the walk's orders, which only a pair's own
 /// light can make ring) it caught pairs of the unscattered part whose mean
-/// is nil to rounding on most sheets. So measured, none of the accuracy
+/// is nil to rounding on most sheets. So measured (a probe counting the
+/// pairs while writing this, not kept), none of the accuracy
 /// tables' sheets has such a pair (their largest clamped energy per node is
 /// 0 in the table); thin tissue with GGX 0.05 faces has 5, with GGX 0.01
 /// 160, with GGX 0.001 175 (of 4096: reflection and transmission, both

@@ -538,7 +538,7 @@ fn walter_projection(bd: &RoughDielectric, outside: &Grid, inside: &Grid, orders
 /// that the nodes' weights do not balance, and a single factor per node
 /// moved the reflection into the transmission: GGX m = 0.01 kept 0.2% of
 /// the 4% Fresnel reflection near the normal (0.05: half; 0.3: within
-/// 5e-3), so a thin sheet with faces smoother than 0.1 reflected up to 0.04
+/// 5e-3; a probe printing the nodes' albedo while writing this, not kept), so a thin sheet with faces smoother than 0.1 reflected up to 0.04
 /// too little at normal incidence (thin tissue at m = 0.01: 0.205 against
 /// the simulator's 0.244) until 2026-12-05. From outside only the sum is
 /// kept: `r_top` takes the rest of the split, and the `slab` model replaces
