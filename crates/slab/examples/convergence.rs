@@ -15,7 +15,8 @@
 //! in-plane value are left out of the relative change (the far tails of a
 //! narrow lobe, where a relative change says nothing a renderer sees).
 //!
-//! `cargo run --release -p paperbsdf-slab --example convergence`
+//! `cargo run --release -p paperbsdf-slab --example convergence [CASE...]`
+//! (optional case names, e.g. `thin-tissue devB`: only those cases).
 
 use paperbsdf_core::bsdf::albedo_from;
 use paperbsdf_core::geometry::in_plane_directions;
@@ -55,7 +56,11 @@ fn albedos(b: &SlabBsdf) -> Vec<f64> {
 }
 
 fn main() {
-    let cases = cases::cases();
+    let only: Vec<String> = std::env::args().skip(1).collect();
+    let cases: Vec<_> = cases::cases()
+        .into_iter()
+        .filter(|(n, _)| only.is_empty() || only.contains(n))
+        .collect();
     let base = SlabOptions::default();
     let variants = [
         (
