@@ -357,7 +357,7 @@ fn scattered_twice_or_more(
             }
             let rhs = &mm * pm;
             let a = DMatrix::identity(n, n) - &mm;
-            a.lu().solve(&rhs).ok_or(SlabError::Singular { step })
+            crate::linalg::solve(a, &rhs).ok_or(SlabError::Singular { step })
         })
         .collect()
 }

@@ -42,6 +42,7 @@
 //! `tau / mu = 28`).
 
 use crate::error::SlabError;
+use crate::linalg;
 use crate::phase::PhaseFourier;
 use crate::quad::Grid;
 use nalgebra::DMatrix;
@@ -119,7 +120,7 @@ impl Layer {
 /// are zero, as for light from outside) its solution is zero; the rest is
 /// solved without it. Anything else is [`SlabError::Singular`].
 fn solve_gap(gap: DMatrix<f64>, rhs: &DMatrix<f64>) -> Result<DMatrix<f64>, SlabError> {
-    if let Some(x) = gap.clone().lu().solve(rhs) {
+    if let Some(x) = linalg::solve(gap.clone(), rhs) {
         if x.iter().all(|v| v.is_finite()) {
             return Ok(x);
         }
@@ -135,7 +136,7 @@ fn solve_gap(gap: DMatrix<f64>, rhs: &DMatrix<f64>) -> Result<DMatrix<f64>, Slab
     }
     let sub = gap.select_rows(&keep).select_columns(&keep);
     let sub_rhs = rhs.select_rows(&keep);
-    let xs = sub.lu().solve(&sub_rhs).ok_or(SlabError::Singular { step: "adding" })?;
+    let xs = linalg::solve(sub, &sub_rhs).ok_or(SlabError::Singular { step: "adding" })?;
     let mut x = DMatrix::zeros(n, rhs.ncols());
     for (r, &k) in keep.iter().enumerate() {
         x.set_row(k, &xs.row(r));
@@ -157,10 +158,7 @@ impl SymmetricLayer {
     pub fn doubled(&self) -> Result<SymmetricLayer, SlabError> {
         let n = self.r.nrows();
         let gap = DMatrix::<f64>::identity(n, n) - &self.r * &self.r;
-        let s = gap
-            .lu()
-            .solve(&self.t)
-            .ok_or(SlabError::Singular { step: "doubling" })?;
+        let s = linalg::solve(gap, &self.t).ok_or(SlabError::Singular { step: "doubling" })?;
         Ok(SymmetricLayer {
             r: &self.r + &self.t * (&self.r * &s),
             t: &self.t * s,
@@ -259,16 +257,13 @@ pub fn medium_layer(
             hb[(i, j)] = f * albedo * phase.opposite[m][(i, j)] * grid.w[j];
         }
     }
-    let lu = (&eye + &ha).lu();
+    let lu = linalg::Factored::new(&eye + &ha);
     let xy = lu
         .solve(&(&eye - &ha))
         .ok_or(SlabError::Singular { step: "starting layer" })?;
     let xz = lu.solve(&hb).ok_or(SlabError::Singular { step: "starting layer" })?;
     let rhs = &xz * (&eye + &xy);
-    let r = (&eye - &xz * &xz)
-        .lu()
-        .solve(&rhs)
-        .ok_or(SlabError::Singular { step: "starting layer" })?;
+    let r = linalg::solve(&eye - &xz * &xz, &rhs).ok_or(SlabError::Singular { step: "starting layer" })?;
     let t = &xy + &xz * &r;
     let mut layer = SymmetricLayer { r, t };
     for _ in 0..k {

@@ -11,7 +11,8 @@
 //! ([`phase`]), each order is a set of reflection and transmission matrices
 //! ([`layer`]); the medium starts as a thin layer and is doubled to its
 //! optical thickness, the faces ([`interface`]) are added to it ([`slab`]).
-//! Orders are independent and solved in parallel (rayon); dense LU by nalgebra.
+//! Orders are independent and solved in parallel (rayon); dense LU by
+//! nalgebra, its triangular solves blocked into matrix products (`linalg`).
 //!
 //! **What exists.** Gauss-Radau / split Gauss-Legendre grids; HG Fourier
 //! coefficients with symmetric normalisation; the diamond starting layer and
@@ -79,8 +80,9 @@
 //! transmission is integrated across its refraction edge since the same
 //! day ([`interface`], "The refraction edge": the very rough sheet moved by
 //! up to 1.07% with twice the nodes, 0.22-0.32% now). Builds
-//! take 0.75 to 0.98 s for the presets (the coated glossy sheet the
-//! slowest). Near `eta_f = eta_b` from
+//! take 0.75 to 0.92 s for the presets (the coated glossy sheet the
+//! slowest; the dense solves' triangular substitutions are blocked,
+//! `linalg`, which made up for the edge's 25 ms per face). Near `eta_f = eta_b` from
 //! below (the base denser) the discretisation moves with the boundary's
 //! critical cosine, by `O(sqrt(eta_b - eta_f))` (8e-5 in the totals at a
 //! difference of 1e-6; tests/coated.rs).
@@ -90,6 +92,7 @@ pub mod error;
 pub mod face_walk;
 pub mod interface;
 pub mod layer;
+mod linalg;
 pub mod phase;
 pub mod quad;
 pub mod slab;
