@@ -563,7 +563,7 @@ pub const EDGE_POINTS: usize = 4;
 /// cells of a denser grid's images are the images of the cells (a coated
 /// sheet's grid, whose cone of total internal reflection holds the images
 /// of the base's).
-fn cells(g: &Grid, n: usize) -> Vec<(f64, f64)> {
+pub(crate) fn cells(g: &Grid, n: usize) -> Vec<(f64, f64)> {
     let mut lo: f64 = 0.0;
     g.w[..n]
         .iter()

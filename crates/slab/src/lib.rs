@@ -67,9 +67,9 @@
 //! (unscattered transmission through rough faces, exact single scattering
 //! as its own term: the tables hold every scattering order, so `slab` has
 //! no separate `single` component); the walk's reflection from outside at
-//! grazing angles on 32 nodes (3.5-6.7% of that component from twice the
-//! nodes at 75 degrees: 0.32-0.36% of the sheets' values, very rough,
-//! devA, luster). The projected faces' R/T split from
+//! grazing angles off a Beckmann 0.15 face on 32 nodes (6.7% of that
+//! component from twice the nodes at 75 R -65: 0.34% of luster's value).
+//! The projected faces' R/T split from
 //! inside is core's at every node; from outside (1e-3 off) it does not
 //! reach the BSDF: the table is rescaled to the transmittance the analytic
 //! face's own albedo leaves ([`bsdf`]). Faces smoother than the grid
@@ -77,12 +77,13 @@
 //! split since 2026-12-05 (tests/smooth_faces.rs: a thin sheet with GGX
 //! 0.01 faces had reflected 0.205 instead of 0.244 at normal incidence, and
 //! R + T reached 1.17 at 30 degrees with GGX 0.001), and GGX faces'
-//! transmission is integrated across its refraction edge since the same
-//! day ([`interface`], "The refraction edge": the very rough sheet moved by
-//! up to 1.07% with twice the nodes, 0.22-0.32% now). Builds
-//! take 0.75 to 0.92 s for the presets (the coated glossy sheet the
+//! kernels are integrated across their edges (where the micro-normal turns
+//! horizontal) since the same day ([`interface`], "The refraction edge";
+//! [`face_walk`], "Edges": the very rough sheet moved by up to 1.07% with
+//! twice the nodes, 0.07-0.22% now). Builds
+//! take 0.71 to 0.92 s for the presets (the coated glossy sheet the
 //! slowest; the dense solves' triangular substitutions are blocked,
-//! `linalg`, which made up for the edge's 25 ms per face). Near `eta_f = eta_b` from
+//! `linalg`, which made up for the edges' 35 ms per face). Near `eta_f = eta_b` from
 //! below (the base denser) the discretisation moves with the boundary's
 //! critical cosine, by `O(sqrt(eta_b - eta_f))` (8e-5 in the totals at a
 //! difference of 1e-6; tests/coated.rs).

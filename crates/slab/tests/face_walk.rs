@@ -32,14 +32,14 @@ fn grids(eta: f64, nodes: usize) -> (Grid, Grid) {
 /// `eval_mode` uses Walter's rational `G1`, within 0.35% of the exact one
 /// per direction (core's microsurface module), so within 0.7% per entry.
 /// Except, for GGX, the transmission entries whose cells the refraction
-/// edge crosses (`interface::refraction_edge_pairs`): the projection holds
-/// the cells' averages there, the chain its values at the nodes; they are
-/// compared apart, within the cell average's difference from a point value
-/// (measured 3.8e-2 of the block's largest entry at m = 0.3 and 0.31 at
-/// m = 0.8, where the edge cuts the cells of the broad lobe's flank; asked
-/// 0.6: a wrong frame or sign would be off by the whole entry, and the
-/// cell averages themselves are checked against core's albedo in
-/// tests/rough_face.rs).
+/// edge crosses (`interface::refraction_edge_pairs`): both average the
+/// cells there, the projection in the flux measure `mu dmu` with 4 points
+/// per axis, the chain in its own measure `dmu` with 2 points per part
+/// (crates/slab/src/face_walk.rs, "Edges"); they are compared apart,
+/// measured 5.8e-3 of the block's largest entry at m = 0.3 and 2.7e-2 at
+/// m = 0.8 (3.8e-2 and 0.31 while the chain sampled the edge at the nodes);
+/// asked 0.05. The cell averages themselves are checked against core's
+/// albedo in tests/rough_face.rs and by the walk's energy below.
 #[test]
 fn order_one_is_walters_projection() {
     let (out, ins) = grids(1.5, 16);
@@ -93,7 +93,7 @@ fn order_one_is_walters_projection() {
             edge.len()
         );
         assert!(worst < tol, "{dist:?} m = {m}: {worst}");
-        assert!(at_edge < 0.6, "{dist:?} m = {m}: {at_edge}");
+        assert!(at_edge < 0.05, "{dist:?} m = {m}: {at_edge}");
     }
 }
 
@@ -150,11 +150,22 @@ fn discretised_walk_returns_what_walter_loses() {
         // Not closer: every scattering of the walk is a quadrature on the
         // nodes of lobes that end in kinks (as Walter's raw projection, up to
         // 3e-2 in albedo, tests/rough_face.rs), and the chain compounds them;
-        // measured 1.2e-2 / 7.6% (GGX 0.3), 3.7e-2 / 11% (GGX 0.6, where the
-        // walk returns up to a third of the light at grazing inside nodes).
-        // The scaling to Walter's loss removes it from the energy; a wrong
-        // factor or frame in the chain shows as errors of order 1.
-        assert!(abs < 0.05 && rel < 0.15, "{dist:?} m = {m}: {abs} {rel}");
+        // measured 8.8e-4 / 0.46% (GGX 0.3), 2.5e-3 / 0.55% (GGX 0.6, where
+        // the walk returns up to a third of the light at grazing inside
+        // nodes), 1.2e-3 / 3.3% (Beckmann 0.45, at a node losing little).
+        // GGX's kernels jump to zero where the micro-normal turns
+        // horizontal (reflection on the diagonal of a hemisphere, refraction
+        // on lines mu_b = eta mu_a): sampled at the nodes, until 2026-12-05,
+        // they left 1.2e-2 / 7.6% and 3.7e-2 / 11%, alternating from node to
+        // node; the chain now averages the cells the edges cross (module
+        // doc, "Edges"). The scaling to Walter's loss removes what is left
+        // from the energy; a wrong factor or frame in the chain shows as
+        // errors of order 1.
+        let (abs_max, rel_max) = match dist {
+            Distribution::Ggx => (5e-3, 1e-2),
+            Distribution::Beckmann => (5e-3, 0.06),
+        };
+        assert!(abs < abs_max && rel < rel_max, "{dist:?} m = {m}: {abs} {rel}");
     }
 }
 
