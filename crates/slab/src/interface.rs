@@ -93,7 +93,8 @@
 //! line Walter's transmission does not fade out, it jumps to zero from `D`
 //! of a horizontal micro-normal (for GGX `m^2 / pi`, a sizable share of
 //! the lobe of a rough face; Beckmann's `D` vanishes there). The line lies
-//! in the cone of total internal reflection (`mu_in <= 1 / eta < mu_c`).
+//! at `mu_in <= 1 / eta`: in the cone of total internal reflection for
+//! `eta > sqrt 2` (`1 / eta < mu_c`), partly beyond it below.
 //! Sampled at the nodes, a jump leaves a quadrature error of the order of
 //! the node spacing times the jump, of either sign depending on where the
 //! edge falls between two nodes: the transmission from outside was off by
@@ -583,13 +584,10 @@ pub(crate) fn cells(g: &Grid, n: usize) -> Vec<(f64, f64)> {
 /// crosses: the entries of the transmission blocks that Walter's
 /// projection of a GGX face holds as cell averages (module doc, "The
 /// refraction edge"). The inside grid is made by [`Grid::inside`] from
-/// `outside`; empty if it has no cone of total internal reflection.
+/// `outside` (or [`Grid::denser`], as a coating's).
 pub fn refraction_edge_pairs(eta: f64, outside: &Grid, inside: &Grid) -> Vec<(usize, usize)> {
-    let Some(n_tir) = inside.len().checked_sub(outside.len()) else {
-        return Vec::new();
-    };
-    let (c_in, c_out) = (cells(inside, n_tir), cells(outside, outside.len()));
-    (0..n_tir)
+    let (c_in, c_out) = (cells(inside, inside.len()), cells(outside, outside.len()));
+    (0..inside.len())
         .flat_map(|a| (0..outside.len()).map(move |b| (a, b)))
         .filter(|&(a, b)| eta * c_in[a].0 < c_out[b].1 && eta * c_in[a].1 > c_out[b].0)
         .collect()
@@ -613,9 +611,6 @@ fn refraction_edge_cells(
     t_down: &mut [DMatrix<f64>],
     t_up: &mut [DMatrix<f64>],
 ) {
-    let Some(n_tir) = inside.len().checked_sub(outside.len()) else {
-        return;
-    };
     // Beckmann's D vanishes (exponentially) at a horizontal micro-normal:
     // its transmission has no edge to integrate.
     match bd.interface {
@@ -623,7 +618,7 @@ fn refraction_edge_cells(
         _ => return,
     }
     let eta = bd.eta;
-    let (c_in, c_out) = (cells(inside, n_tir), cells(outside, outside.len()));
+    let (c_in, c_out) = (cells(inside, inside.len()), cells(outside, outside.len()));
     let crossed = refraction_edge_pairs(eta, outside, inside);
     let (x, wx) = gauss_legendre_01(EDGE_POINTS);
     let sin = |mu: f64| (1.0 - mu * mu).max(0.0).sqrt();
