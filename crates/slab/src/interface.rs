@@ -111,7 +111,8 @@
 //! reciprocity): the raw transmission is then within 1.3e-3 of core's at
 //! every node (GGX m = 0.9; 5.3e-4 at 0.5; tests/rough_face.rs), and
 //! neighbouring factors within 2e-3. Only GGX faces have the edge; it costs
-//! about 25 ms per face (44 pairs with the default 32 nodes).
+//! about 25 ms per face (44 pairs with the default 32 nodes; timed inside
+//! the build while writing this).
 
 //! **Multiple scattering on the microsurface** (`face_scattering =
 //! "multiple"`): the face the simulator has, the random walk on the Smith
