@@ -66,9 +66,10 @@
 //! diagonal since 2026-12-05, by 0.15%); further analytic parts
 //! (unscattered transmission through rough faces, exact single scattering
 //! as its own term: the tables hold every scattering order, so `slab` has
-//! no separate `single` component); the walk's reflection from outside at
-//! grazing angles off a Beckmann 0.15 face on 32 nodes (6.7% of that
-//! component from twice the nodes at 75 R -65: 0.34% of luster's value).
+//! no separate `single` component); the flank of the walk's forward peak
+//! at grazing angles off a Beckmann 0.15 face, interpolated linearly in
+//! `mu_o` between 32 nodes (luster at 75 R -65: 0.34% from twice the
+//! nodes; at the nodes themselves within 0.04%).
 //! The projected faces' R/T split from
 //! inside is core's at every node; from outside (1e-3 off) it does not
 //! reach the BSDF: the table is rescaled to the transmittance the analytic
