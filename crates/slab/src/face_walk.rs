@@ -80,7 +80,7 @@ use crate::interface::{azimuth_rule, cells, scale_rows_cols};
 use crate::layer::Layer;
 use crate::quad::Grid;
 use nalgebra::DMatrix;
-use paperbsdf_core::microsurface::Microsurface;
+use paperbsdf_core::microsurface::{Microsurface, Scatterer};
 use paperbsdf_core::quadrature::gauss_legendre_01;
 use paperbsdf_core::{DVec3, Distribution, Microfacet};
 use rayon::prelude::*;
@@ -191,6 +191,18 @@ fn edge_crosses(e: (f64, f64), a: &State, b: &State) -> bool {
     corners.iter().any(|&v| v < 0.0) && corners.iter().any(|&v| v > 0.0)
 }
 
+/// The chain's kernel from state `a` (scattered by `sc`) into the direction
+/// `vb` of state `b`'s side: a reflection on the same side, a refraction
+/// (in the other side's frame, turned over) otherwise.
+#[inline(always)]
+fn kernel(sc: &Scatterer, a: &State, b: &State, vb: DVec3) -> f64 {
+    if a.outside == b.outside {
+        sc.density(vb, true)
+    } else {
+        sc.density(-vb, false)
+    }
+}
+
 /// The kernel from `a` to `b` at the azimuths `phis`, averaged over the two
 /// cells (in `mu`, the chain's measure), the cell of `b` split at the edge
 /// (module doc, "Edges").
@@ -217,13 +229,7 @@ fn edge_average(s: &Microsurface, a: &State, b: &State, e: (f64, f64), phis: &[(
                 };
                 let weight = wa * wb * (p1 - p0) / (hb - lb);
                 for (v, &(c, sn)) in row.iter_mut().zip(phis) {
-                    let vb = sb.dir(c, sn);
-                    *v += weight
-                        * if a.outside == b.outside {
-                            sc.density(vb, true)
-                        } else {
-                            sc.density(-vb, false)
-                        };
+                    *v += weight * kernel(&sc, a, b, sb.dir(c, sn));
                 }
             }
         }
@@ -256,12 +262,7 @@ fn phase_matrices_from(s: &Microsurface, st: &[State], from: usize, orders: usiz
             let mut vals = DMatrix::from_fn(n, n_phi, |b_idx, k| {
                 let b = &st[b_idx];
                 let (c, sn) = phis[k];
-                let vb = b.dir(c, sn);
-                if a.outside == b.outside {
-                    sc.density(vb, true)
-                } else {
-                    sc.density(-vb, false)
-                }
+                kernel(&sc, a, b, b.dir(c, sn))
             });
             if ggx {
                 let mut row = vec![0.0; n_phi];

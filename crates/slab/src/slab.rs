@@ -421,11 +421,13 @@ impl Solution {
     /// outside node `j` arriving at `side`: `sum_o w_o mu_o K[o][j] / (w_j mu_j)`.
     /// A rough lit face's split between its own reflection and what enters
     /// is the projection's (crate::interface, "Quadrature in `mu` and
-    /// normalisation": within 2.2e-3 of core's for paper-like faces; more
-    /// for a face smoother than the grid at grazing incidence: thin tissue
-    /// with GGX 0.001 faces reflects 0.856 at 86.9 degrees here, the smooth
-    /// sheet 0.841), which the `slab` model's BSDF replaces by the analytic
-    /// lobe (0.842 for that sheet, tests/smooth_faces.rs).
+    /// normalisation": within 1.1e-3 of core's for paper-like faces,
+    /// tests/rough_face.rs; more for a face smoother than the grid at grazing
+    /// incidence: thin tissue with GGX 0.001 faces reflects 0.856 at 86.9
+    /// degrees here, the smooth sheet 0.841, a probe's numbers), which the
+    /// `slab` model's BSDF replaces by the analytic lobe (0.842 for that
+    /// sheet; tests/smooth_faces.rs checks such sheets against the smooth
+    /// one).
     pub fn totals_collimated(&self, side: Side, j: usize) -> (f64, f64) {
         let g = &self.outside;
         let (r, t) = self.rt0(side);
