@@ -4,16 +4,42 @@
 //! (`SlabBsdf::new`: the faces' projection, one adding-doubling solve per
 //! distinct colour channel and one without scattering, the tables and the
 //! sampling densities) for matte (RGB absorption: three channels) and
-//! luster (two distinct faces, one channel).
+//! luster (two distinct faces, one channel); eval, pdf and sample also for
+//! the worst cases of the per-call work: glossy (a coated front, Beckmann
+//! 0.04, whose lobe is sampled more often) and a thin tissue sheet (the
+//! spread's, docs/accuracy.md: tau 1.2, mostly transmission).
 //! Run with `cargo bench -p paperbsdf-slab --bench slab`.
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use paperbsdf_core::presets;
-use paperbsdf_core::{Bsdf, DVec3};
+use paperbsdf_core::{Bsdf, Colour, DVec3, Distribution, PaperParams};
 use paperbsdf_slab::SlabBsdf;
 
+/// The thin tissue sheet of docs/accuracy.md (crates/sim/examples/support/cases.rs).
+fn thin_tissue() -> PaperParams {
+    PaperParams {
+        name: Some("thin tissue".into()),
+        d: 0.03,
+        sigma_a: Colour::Scalar(0.3),
+        sigma_s: Colour::Scalar(40.0),
+        g_f: 0.8,
+        g_b: -0.3,
+        w_b: 0.2,
+        eta_f: 1.5,
+        eta_b: 1.5,
+        m_f: 0.3,
+        m_b: 0.3,
+        dist_f: Distribution::Ggx,
+        dist_b: Distribution::Ggx,
+        face_scattering: Default::default(),
+    }
+}
+
 fn bench(c: &mut Criterion) {
-    for name in ["matte", "luster"] {
-        let p = presets::preset(name).unwrap();
+    for name in ["matte", "luster", "glossy", "thin-tissue"] {
+        let p = match name {
+            "thin-tissue" => thin_tissue(),
+            _ => presets::preset(name).unwrap(),
+        };
         let b = SlabBsdf::new(&p).unwrap();
         let wo = DVec3::new(0.3, 0.1, 0.9).normalize();
         let wi_r = DVec3::new(-0.4, 0.2, 0.8).normalize();
