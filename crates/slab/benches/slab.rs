@@ -11,33 +11,23 @@
 //! Run with `cargo bench -p paperbsdf-slab --bench slab`.
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use paperbsdf_core::presets;
-use paperbsdf_core::{Bsdf, Colour, DVec3, Distribution, PaperParams};
+use paperbsdf_core::{Bsdf, DVec3};
 use paperbsdf_slab::SlabBsdf;
 
-/// The thin tissue sheet of docs/accuracy.md (crates/sim/examples/support/cases.rs).
-fn thin_tissue() -> PaperParams {
-    PaperParams {
-        name: Some("thin tissue".into()),
-        d: 0.03,
-        sigma_a: Colour::Scalar(0.3),
-        sigma_s: Colour::Scalar(40.0),
-        g_f: 0.8,
-        g_b: -0.3,
-        w_b: 0.2,
-        eta_f: 1.5,
-        eta_b: 1.5,
-        m_f: 0.3,
-        m_b: 0.3,
-        dist_f: Distribution::Ggx,
-        dist_b: Distribution::Ggx,
-        face_scattering: Default::default(),
-    }
-}
+// The cases of docs/accuracy.md, as the accuracy example has them (thin tissue).
+#[path = "../../sim/examples/support/cases.rs"]
+mod cases;
 
 fn bench(c: &mut Criterion) {
     for name in ["matte", "luster", "glossy", "thin-tissue"] {
         let p = match name {
-            "thin-tissue" => thin_tissue(),
+            "thin-tissue" => {
+                cases::cases()
+                    .into_iter()
+                    .find(|(n, _)| n == name)
+                    .expect("the accuracy cases have thin tissue")
+                    .1
+            }
             _ => presets::preset(name).unwrap(),
         };
         let b = SlabBsdf::new(&p).unwrap();
