@@ -1,6 +1,7 @@
 //! Speed of the model `slab` (issue 13's targets: one build <= 1 s for
 //! paper-like sheets, eval <= 200 ns, sample <= 300 ns): eval in reflection
-//! and transmission, pdf, sample, at directions off the nodes, and the build
+//! and transmission, eval at grazing angles near the mirror direction (the
+//! most Fourier orders), pdf, sample, at directions off the nodes, and the build
 //! (`SlabBsdf::new`: the faces' projection, one adding-doubling solve per
 //! distinct colour channel and one without scattering, the tables and the
 //! sampling densities) for matte (RGB absorption: three channels) and
@@ -45,6 +46,18 @@ fn bench(c: &mut Criterion) {
         c.bench_function(&format!("slab/{name}/eval_transmission"), |bn| {
             bn.iter(|| {
                 let d = black_box(&dt);
+                black_box(&b).eval(d.0, d.1)
+            })
+        });
+        // Grazing, near the mirror direction (off the nodes): the node pairs
+        // there keep the most Fourier orders (the lit face's walk, to
+        // `SlabOptions::walk_orders`), the worst case of `eval`.
+        let wo_g = DVec3::new(0.985, 0.05, 0.16).normalize();
+        let wi_g = DVec3::new(-0.975, 0.1, 0.21).normalize();
+        let dg = (wi_g, wo_g);
+        c.bench_function(&format!("slab/{name}/eval_grazing"), |bn| {
+            bn.iter(|| {
+                let d = black_box(&dg);
                 black_box(&b).eval(d.0, d.1)
             })
         });

@@ -1181,38 +1181,145 @@ fn fejer_where_ringing(
     }
 }
 
+/// `a_m = r^m cos(m phi)` for `m = 0..out.len()` (`c = cos phi`, `0 <= r <=
+/// 1`): the first 16 by the recurrence `a_{m+1} = 2 r c a_m - r^2
+/// a_{m-1}`, the rest by its eight-step form `a_m = 2 r^8 cos(8 phi)
+/// a_{m-8} - r^16 a_{m-16}` (`r^m e^{i m phi}`'s real part, stepped by
+/// `(r e^{i phi})^8`), a block of eight at a time: eight independent chains,
+/// so the loop is not bound by the latency of one multiply and subtract per
+/// order (one chain per node pair made `eval` at grazing pairs, which keep
+/// up to [`SlabOptions::walk_orders`] orders, take 1.0-1.9 us; criterion,
+/// benches/slab.rs `eval_grazing`). Rounding grows like the standard
+/// recurrence's (`O(m^2 eps)` at worst, below 1e-11 at 512 orders;
+/// `cos_series_is_the_cosines` checks it against `cos` directly).
+#[inline(always)]
+fn cos_series(out: &mut [f64], c: f64, r: f64) {
+    let (rc, r2) = (r * c, r * r);
+    let head = out.len().min(16);
+    if head == 0 {
+        return;
+    }
+    out[0] = 1.0;
+    if head > 1 {
+        out[1] = rc;
+    }
+    for m in 2..head {
+        out[m] = 2.0 * rc * out[m - 1] - r2 * out[m - 2];
+    }
+    if out.len() <= 16 {
+        return;
+    }
+    // 2 r^8 cos(8 phi) = 2 a_8, and r^16.
+    let r4 = r2 * r2;
+    let (two_a8, r16) = (2.0 * out[8], r4 * r4 * r4 * r4);
+    let mut m = 16;
+    while m + 8 <= out.len() {
+        let (done, next) = out.split_at_mut(m);
+        let (back16, back8) = done[m - 16..].split_at(8);
+        for l in 0..8 {
+            next[l] = two_a8 * back8[l] - r16 * back16[l];
+        }
+        m += 8;
+    }
+    for i in m..out.len() {
+        out[i] = two_a8 * out[i - 8] - r16 * out[i - 16];
+    }
+}
+
+/// `sum_m s_m t_m` per channel of a node pair's interleaved orders `row`
+/// (`K` channels per order) against `t` (at least as long), with eight
+/// partial sums per channel so that the additions do not form one chain.
+#[inline(always)]
+fn dot_orders<const K: usize>(row: &[f64], t: &[f64]) -> [f64; K] {
+    let mut s = [[0.0f64; K]; 8];
+    let whole = row.len() / (8 * K);
+    for (a8, t8) in row.chunks_exact(8 * K).zip(t.chunks_exact(8)) {
+        for q in 0..8 {
+            for k in 0..K {
+                s[q][k] += a8[q * K + k] * t8[q];
+            }
+        }
+    }
+    for (a, &tm) in row[whole * 8 * K..].chunks_exact(K).zip(&t[whole * 8..]) {
+        for k in 0..K {
+            s[0][k] += a[k] * tm;
+        }
+    }
+    std::array::from_fn(|k| ((s[0][k] + s[1][k]) + (s[2][k] + s[3][k])) + ((s[4][k] + s[5][k]) + (s[6][k] + s[7][k])))
+}
+
 /// The Fourier series `sum_m s_m cos(m phi)` (`c = cos phi`) of the three
 /// node pairs `pairs` of a table `tab` with `K` channels, weighted by
-/// `weights`: each pair over the orders it keeps, summed with `cos(m phi)`
-/// by the Chebyshev recurrence.
+/// `weights`: each pair over the orders it keeps, against `cos(m phi)`
+/// computed once for the longest ([`cos_series`], [`dot_orders`]).
 #[inline(always)]
 fn fourier_sum<const K: usize>(tab: &Tables, st: usize, pairs: [usize; 3], weights: [f64; 3], c: f64) -> [f64; K] {
     let t = &tab.c[st >> 1][st & 1];
     let (start, len) = (&tab.start[st >> 1][st & 1], &tab.len[st >> 1][st & 1]);
-    let mut acc = [0.0f64; K];
-    for (&p, &w) in pairs.iter().zip(&weights) {
-        if w == 0.0 {
-            continue;
-        }
-        let from = start[p] as usize * K;
-        let row = &t[from..from + len[p] as usize * K];
-        let (mut c_prev, mut c_m) = (w * c, w);
-        for a in row.chunks_exact(K) {
-            for k in 0..K {
-                acc[k] += a[k] * c_m;
+    let longest = pairs
+        .iter()
+        .zip(&weights)
+        .filter(|(_, &w)| w != 0.0)
+        .map(|(&p, _)| len[p] as usize)
+        .max()
+        .unwrap_or(0);
+    let sum = |cos_m: &mut [f64]| {
+        cos_series(&mut cos_m[..longest], c, 1.0);
+        let mut acc = [0.0f64; K];
+        for (&p, &w) in pairs.iter().zip(&weights) {
+            if w == 0.0 {
+                continue;
             }
-            let next = 2.0 * c * c_m - c_prev;
-            c_prev = c_m;
-            c_m = next;
+            let from = start[p] as usize * K;
+            let row = &t[from..from + len[p] as usize * K];
+            let s = dot_orders::<K>(row, cos_m);
+            for k in 0..K {
+                acc[k] += w * s[k];
+            }
         }
+        acc
+    };
+    // Most pairs keep a few orders: one chain per pair is cheapest there
+    // (no buffer to clear); above, a buffer no longer than needed.
+    match longest {
+        l if l <= SHORT_SERIES => {
+            let mut acc = [0.0f64; K];
+            for (&p, &w) in pairs.iter().zip(&weights) {
+                if w == 0.0 {
+                    continue;
+                }
+                let from = start[p] as usize * K;
+                let row = &t[from..from + len[p] as usize * K];
+                let (mut c_prev, mut c_m) = (w * c, w);
+                for a in row.chunks_exact(K) {
+                    for k in 0..K {
+                        acc[k] += a[k] * c_m;
+                    }
+                    let next = 2.0 * c * c_m - c_prev;
+                    c_prev = c_m;
+                    c_m = next;
+                }
+            }
+            acc
+        }
+        l if l <= 64 => sum(&mut [0.0f64; 64]),
+        l if l <= 128 => sum(&mut [0.0f64; 128]),
+        l if l <= 256 => sum(&mut [0.0f64; 256]),
+        _ => sum(&mut [0.0f64; MAX_ORDERS]),
     }
-    acc
 }
+
+/// Orders up to which [`fourier_sum`] sums each node pair by its own
+/// recurrence (as before 2026-12-05): for a few orders that is cheaper
+/// than filling a buffer (matte's `eval_reflection` in benches/slab.rs, at
+/// mid angles where the pairs keep few orders: 84 ns against 109 with the
+/// buffer for every pair).
+const SHORT_SERIES: usize = 16;
 
 /// The table near the pole ([`pole_corners`]): order 0 from the triangles'
 /// three node pairs `pairs` and `weights` (as [`fourier_sum`]), the orders
 /// `m >= 1` from the two node pairs of `pole` with their weights, summed with
-/// `r^m cos(m phi)` by the recurrence `a_{m+1} = 2 r c a_m - r^2 a_{m-1}`.
+/// `r^m cos(m phi)` ([`cos_series`]).
 fn fourier_sum_pole<const K: usize>(
     tab: &Tables,
     st: usize,
@@ -1229,21 +1336,25 @@ fn fourier_sum_pole<const K: usize>(
             *a += w * t[start[p] as usize * K + k];
         }
     }
-    let (rc, r2) = (pole.r * c, pole.r * pole.r);
+    let longest = pole
+        .pairs
+        .iter()
+        .zip(&pole.weights)
+        .filter(|(_, &w)| w != 0.0)
+        .map(|(&p, _)| len[p] as usize)
+        .max()
+        .unwrap_or(0);
+    let mut a_m = [0.0f64; MAX_ORDERS];
+    cos_series(&mut a_m[..longest], c, pole.r);
     for (&p, &w) in pole.pairs.iter().zip(&pole.weights) {
-        if w == 0.0 {
+        if w == 0.0 || len[p] < 2 {
             continue;
         }
-        let from = start[p] as usize * K;
-        let row = &t[from..from + len[p] as usize * K];
-        let (mut a_prev, mut a_m) = (w, w * rc);
-        for a in row.chunks_exact(K).skip(1) {
-            for (k, x) in acc.iter_mut().enumerate() {
-                *x += a[k] * a_m;
-            }
-            let next = 2.0 * rc * a_m - r2 * a_prev;
-            a_prev = a_m;
-            a_m = next;
+        let from = (start[p] as usize + 1) * K;
+        let row = &t[from..from + (len[p] as usize - 1) * K];
+        let s = dot_orders::<K>(row, &a_m[1..longest]);
+        for (k, x) in acc.iter_mut().enumerate() {
+            *x += w * s[k];
         }
     }
     acc
@@ -2171,7 +2282,9 @@ impl ComponentModel for SlabBsdf {
 
 #[cfg(test)]
 mod tests {
-    use super::{locate, ridge_ratios, shape_at, triangle_weights, CellDensity, SHAPE_STEPS};
+    use super::{
+        cos_series, dot_orders, locate, ridge_ratios, shape_at, triangle_weights, CellDensity, MAX_ORDERS, SHAPE_STEPS,
+    };
     use paperbsdf_core::Rgb;
     use std::f64::consts::PI;
 
@@ -2240,6 +2353,51 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    /// `cos_series` against `r^m cos(m phi)` computed directly, at every
+    /// length around its switch from the one-step to the eight-step
+    /// recurrence and at the longest series, for azimuths where the
+    /// recurrences are least stable (`phi` near 0, `pi / 8`, `pi / 2`, `pi`)
+    /// and damping `r` of the pole's orders; and `dot_orders` against the
+    /// plain sum, for every remainder of its blocks and both channel counts.
+    #[test]
+    fn cos_series_is_the_cosines() {
+        let mut worst = 0.0f64;
+        for phi in [0.0, 1e-7, 0.3, PI / 8.0, 1.0, PI / 2.0 - 1e-9, 2.5, PI - 1e-6, PI] {
+            let c = f64::cos(phi);
+            for r in [1.0f64, 0.93, 0.5, 0.0] {
+                for len in (0..=40).chain([255, 256, 257, MAX_ORDERS]) {
+                    let mut out = vec![f64::NAN; len];
+                    cos_series(&mut out, c, r);
+                    for (m, &v) in out.iter().enumerate() {
+                        let want = r.powi(m as i32) * (m as f64 * c.acos()).cos();
+                        worst = worst.max((v - want).abs());
+                        assert!(
+                            (v - want).abs() < 1e-11,
+                            "phi {phi} r {r} len {len} m {m}: {v} vs {want}"
+                        );
+                    }
+                }
+            }
+        }
+        eprintln!("cos_series: largest error {worst:.1e}");
+        for len in 0..40 {
+            let t: Vec<f64> = (0..len).map(|m| (m as f64 * 0.37).cos()).collect();
+            let row3: Vec<f64> = (0..3 * len).map(|i| ((i * 7919) % 101) as f64 / 101.0 - 0.3).collect();
+            let got = dot_orders::<3>(&row3, &t);
+            for k in 0..3 {
+                let want: f64 = (0..len).map(|m| row3[3 * m + k] * t[m]).sum();
+                assert!(
+                    (got[k] - want).abs() < 1e-12,
+                    "len {len} channel {k}: {} vs {want}",
+                    got[k]
+                );
+            }
+            let got = dot_orders::<1>(&row3[..len], &t);
+            let want: f64 = (0..len).map(|m| row3[m] * t[m]).sum();
+            assert!((got[0] - want).abs() < 1e-12, "len {len}: {} vs {want}", got[0]);
         }
     }
 
