@@ -1256,56 +1256,48 @@ fn dot_orders<const K: usize>(row: &[f64], t: &[f64]) -> [f64; K] {
 fn fourier_sum<const K: usize>(tab: &Tables, st: usize, pairs: [usize; 3], weights: [f64; 3], c: f64) -> [f64; K] {
     let t = &tab.c[st >> 1][st & 1];
     let (start, len) = (&tab.start[st >> 1][st & 1], &tab.len[st >> 1][st & 1]);
-    let longest = pairs
-        .iter()
-        .zip(&weights)
-        .filter(|(_, &w)| w != 0.0)
-        .map(|(&p, _)| len[p] as usize)
-        .max()
-        .unwrap_or(0);
-    let sum = |cos_m: &mut [f64]| {
-        cos_series(&mut cos_m[..longest], c, 1.0);
-        let mut acc = [0.0f64; K];
-        for (&p, &w) in pairs.iter().zip(&weights) {
-            if w == 0.0 {
-                continue;
-            }
+    // The pairs that take part, with their weights and orders.
+    let rows = || {
+        pairs.iter().zip(&weights).filter(|(_, &w)| w != 0.0).map(|(&p, &w)| {
             let from = start[p] as usize * K;
-            let row = &t[from..from + len[p] as usize * K];
-            let s = dot_orders::<K>(row, cos_m);
+            (w, &t[from..from + len[p] as usize * K])
+        })
+    };
+    let weighted = |series: &dyn Fn(&[f64]) -> [f64; K]| {
+        let mut acc = [0.0f64; K];
+        for (w, row) in rows() {
+            let s = series(row);
             for k in 0..K {
                 acc[k] += w * s[k];
             }
         }
         acc
     };
-    // Most pairs keep a few orders: one chain per pair is cheapest there
-    // (no buffer to clear); above, a buffer no longer than needed.
+    let longest = rows().map(|(_, row)| row.len() / K).max().unwrap_or(0);
+    let buffered = |cos_m: &mut [f64]| {
+        cos_series(&mut cos_m[..longest], c, 1.0);
+        weighted(&|row| dot_orders::<K>(row, cos_m))
+    };
+    // Most pairs keep a few orders: one recurrence per pair is cheapest
+    // there (no buffer to clear); above, a buffer no longer than needed.
     match longest {
-        l if l <= SHORT_SERIES => {
-            let mut acc = [0.0f64; K];
-            for (&p, &w) in pairs.iter().zip(&weights) {
-                if w == 0.0 {
-                    continue;
+        l if l <= SHORT_SERIES => weighted(&|row| {
+            let mut s = [0.0f64; K];
+            let (mut c_prev, mut c_m) = (c, 1.0);
+            for a in row.chunks_exact(K) {
+                for k in 0..K {
+                    s[k] += a[k] * c_m;
                 }
-                let from = start[p] as usize * K;
-                let row = &t[from..from + len[p] as usize * K];
-                let (mut c_prev, mut c_m) = (w * c, w);
-                for a in row.chunks_exact(K) {
-                    for k in 0..K {
-                        acc[k] += a[k] * c_m;
-                    }
-                    let next = 2.0 * c * c_m - c_prev;
-                    c_prev = c_m;
-                    c_m = next;
-                }
+                let next = 2.0 * c * c_m - c_prev;
+                c_prev = c_m;
+                c_m = next;
             }
-            acc
-        }
-        l if l <= 64 => sum(&mut [0.0f64; 64]),
-        l if l <= 128 => sum(&mut [0.0f64; 128]),
-        l if l <= 256 => sum(&mut [0.0f64; 256]),
-        _ => sum(&mut [0.0f64; MAX_ORDERS]),
+            s
+        }),
+        l if l <= 64 => buffered(&mut [0.0f64; 64]),
+        l if l <= 128 => buffered(&mut [0.0f64; 128]),
+        l if l <= 256 => buffered(&mut [0.0f64; 256]),
+        _ => buffered(&mut [0.0f64; MAX_ORDERS]),
     }
 }
 
