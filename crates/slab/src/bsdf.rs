@@ -1294,10 +1294,20 @@ fn fourier_sum<const K: usize>(tab: &Tables, st: usize, pairs: [usize; 3], weigh
             }
             s
         }),
-        l if l <= 64 => buffered(&mut [0.0f64; 64]),
-        l if l <= 128 => buffered(&mut [0.0f64; 128]),
-        l if l <= 256 => buffered(&mut [0.0f64; 256]),
-        _ => buffered(&mut [0.0f64; MAX_ORDERS]),
+        _ => with_series_buffer(longest, buffered),
+    }
+}
+
+/// Runs `f` on a zeroed buffer for a series of `len` orders (at most
+/// [`MAX_ORDERS`]): the first of 64, 128, 256 or [`MAX_ORDERS`] values that
+/// holds it, as clearing the buffer costs in proportion to its length.
+#[inline(always)]
+fn with_series_buffer<R>(len: usize, f: impl FnOnce(&mut [f64]) -> R) -> R {
+    match len {
+        l if l <= 64 => f(&mut [0.0f64; 64]),
+        l if l <= 128 => f(&mut [0.0f64; 128]),
+        l if l <= 256 => f(&mut [0.0f64; 256]),
+        _ => f(&mut [0.0f64; MAX_ORDERS]),
     }
 }
 
@@ -1336,20 +1346,21 @@ fn fourier_sum_pole<const K: usize>(
         .map(|(&p, _)| len[p] as usize)
         .max()
         .unwrap_or(0);
-    let mut a_m = [0.0f64; MAX_ORDERS];
-    cos_series(&mut a_m[..longest], c, pole.r);
-    for (&p, &w) in pole.pairs.iter().zip(&pole.weights) {
-        if w == 0.0 || len[p] < 2 {
-            continue;
+    with_series_buffer(longest, |a_m| {
+        cos_series(&mut a_m[..longest], c, pole.r);
+        for (&p, &w) in pole.pairs.iter().zip(&pole.weights) {
+            if w == 0.0 || len[p] < 2 {
+                continue;
+            }
+            let from = (start[p] as usize + 1) * K;
+            let row = &t[from..from + (len[p] as usize - 1) * K];
+            let s = dot_orders::<K>(row, &a_m[1..longest]);
+            for (k, x) in acc.iter_mut().enumerate() {
+                *x += w * s[k];
+            }
         }
-        let from = (start[p] as usize + 1) * K;
-        let row = &t[from..from + (len[p] as usize - 1) * K];
-        let s = dot_orders::<K>(row, &a_m[1..longest]);
-        for (k, x) in acc.iter_mut().enumerate() {
-            *x += w * s[k];
-        }
-    }
-    acc
+        acc
+    })
 }
 
 /// The node pairs and weights of the orders `m >= 1` near the pole (module
@@ -2064,8 +2075,17 @@ impl SlabBsdf {
         let x = phi / dphi;
         let b = (x as usize).min(self.phi_bins - 1);
         let x = x - b as f64;
-        let e = (h * self.mu_bins + k) * (self.phi_bins + 1) + b;
+        let e = self.edge_index(h, k, b);
         self.table_pdf_in(wo, CellPlace { e, x }, wi.z.abs())
+    }
+
+    /// Where the lower `|phi|` edge of the cell `(h, k, b)` (hemisphere, bin
+    /// in `mu`, bin in `|phi|`) is in a [`CellDensity`]'s `edge`: the order
+    /// in which `cell_density` writes them, and what `sample_table` hands to
+    /// [`SlabBsdf::table_pdf_in`] must equal what `table_pdf` finds.
+    #[inline]
+    fn edge_index(&self, h: usize, k: usize, b: usize) -> usize {
+        (h * self.mu_bins + k) * (self.phi_bins + 1) + b
     }
 
     /// [`SlabBsdf::table_pdf`] of a `wi` at cosine `mu_i` whose cell is
@@ -2115,7 +2135,7 @@ impl SlabBsdf {
         let mu = (k as f64 + u[0]) / nb as f64;
         // Within the cell the density is linear in |phi| from `a` to `c`:
         // invert its cumulative `(a x + (c - a) x^2 / 2) / ((a + c) / 2)`.
-        let e = (h * nb + k) * (pb + 1) + b;
+        let e = self.edge_index(h, k, b);
         let (a, c) = (cd.edge[e], cd.edge[e + 1]);
         let x_phi = if (c - a).abs() <= 1e-9 * (a + c) {
             u[1]
