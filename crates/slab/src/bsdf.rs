@@ -143,6 +143,8 @@
 use crate::error::SlabError;
 use crate::interface::walk_window;
 use crate::slab::{Discretisation, SlabSpec, Solution};
+use multiversion::multiversion;
+use multiversion::target::target_cfg_f;
 use nalgebra::DMatrix;
 use paperbsdf_core::bsdf::{Bsdf, BsdfFlags, BsdfSample};
 use paperbsdf_core::fresnel::{cos_transmitted, fresnel_dielectric};
@@ -272,10 +274,13 @@ impl SmoothSheet {
 /// the number of orders that matter for each node pair.
 #[derive(Clone, Debug, Default)]
 struct Tables {
-    /// Channel `k` of `c_m[o][j]` at `(start[p] + m) K + k`, `p = o n + j`,
-    /// `m < len[p]`, with `K` = [`Tables::channels`]: each pair stores only
-    /// the orders it keeps (the walk's reflection at grazing incidence
-    /// needs up to [`SlabOptions::walk_orders`], most pairs a few).
+    /// Channel `k` of `c_m[o][j]` at `start[p] K + k len[p] + m`, `p = o n +
+    /// j`, `m < len[p]`, with `K` = [`Tables::channels`]: each pair stores
+    /// only the orders it keeps (the walk's reflection at grazing incidence
+    /// needs up to [`SlabOptions::walk_orders`], most pairs a few), a
+    /// channel's orders contiguous (one vectorised sum per channel; with
+    /// the channels interleaved, as until 2026-12-06, three-channel sheets
+    /// could not use four lanes).
     c: [[Vec<f64>; 2]; 2],
     /// Per pair `p = o n + j`: the orders `0..len` kept, the fewest whose
     /// dropped tail sums to at most [`ORDER_CUTOFF`] of the pair's largest
@@ -361,8 +366,8 @@ impl Tables {
                 for (p, &l) in sym[s][t].iter().enumerate() {
                     start[s][t].push(at);
                     at += u32::from(l);
-                    for v in &c[s][t][p * orders..p * orders + l as usize] {
-                        packed.extend(v.0.into_iter().take(channels));
+                    for k in 0..channels {
+                        packed.extend(c[s][t][p * orders..p * orders + l as usize].iter().map(|v| v.0[k]));
                     }
                 }
                 packed
@@ -1182,120 +1187,201 @@ fn fejer_where_ringing(
 }
 
 /// `a_m = r^m cos(m phi)` for `m = 0..out.len()` (`c = cos phi`, `0 <= r <=
-/// 1`): the first 16 by the recurrence `a_{m+1} = 2 r c a_m - r^2
-/// a_{m-1}`, the rest by its eight-step form `a_m = 2 r^8 cos(8 phi)
-/// a_{m-8} - r^16 a_{m-16}` (`r^m e^{i m phi}`'s real part, stepped by
-/// `(r e^{i phi})^8`), a block of eight at a time: eight independent chains,
-/// so the loop is not bound by the latency of one multiply and subtract per
-/// order (one chain per node pair made `eval` at grazing pairs, which keep
-/// up to [`SlabOptions::walk_orders`] orders, take 1.0-1.9 us; criterion,
-/// benches/slab.rs `eval_grazing`). Rounding grows like the standard
-/// recurrence's (`O(m^2 eps)` at worst, below 1e-11 at 512 orders;
-/// `cos_series_is_the_cosines` checks it against `cos` directly).
+/// 1`), by doubling: from `cos 0 = 1`, `cos phi = c` and the cosines up to
+/// `s phi`, the next `s` at once by the product formula `cos((s+j) phi) =
+/// 2 cos(s phi) cos(j phi) - cos((s-j) phi)`,
+/// so `s` = 1, 2, 4, ... and 256 orders take eight steps, each one
+/// vectorised loop without a chain through its values; for `r < 1` (the
+/// pole's orders, [`fourier_sum_pole`]) the cosines are then multiplied by
+/// `r^m`, eight powers at a time. Until 2026-12-06 a recurrence stepped eight orders at
+/// a time (eight chains; one chain per node pair before 2026-12-05): its
+/// chain through the stored values was about half of `eval` at grazing
+/// pairs, which keep up to [`SlabOptions::walk_orders`] orders (a perf
+/// profile; criterion benches/slab.rs `eval_grazing`). Rounding grows like
+/// `m eps` per doubling at worst (`cos_series_is_the_cosines` checks it
+/// against `cos` directly: below 1e-11 at [`MAX_ORDERS`]).
 #[inline(always)]
 fn cos_series(out: &mut [f64], c: f64, r: f64) {
-    let (rc, r2) = (r * c, r * r);
-    let head = out.len().min(16);
-    if head == 0 {
+    const STRIDE: usize = 32;
+    let n = out.len();
+    if n == 0 {
         return;
     }
     out[0] = 1.0;
-    if head > 1 {
-        out[1] = rc;
-    }
-    for m in 2..head {
-        out[m] = 2.0 * rc * out[m - 1] - r2 * out[m - 2];
-    }
-    if out.len() <= 16 {
+    if n == 1 {
         return;
     }
-    // 2 r^8 cos(8 phi) = 2 a_8, and r^16.
-    let r4 = r2 * r2;
-    let (two_a8, r16) = (2.0 * out[8], r4 * r4 * r4 * r4);
-    let mut m = 16;
-    while m + 8 <= out.len() {
-        let (done, next) = out.split_at_mut(m);
-        let (back16, back8) = done[m - 16..].split_at(8);
-        for l in 0..8 {
-            next[l] = two_a8 * back8[l] - r16 * back16[l];
+    out[1] = c;
+    let head = n.min(2 * STRIDE);
+    let mut s = 1;
+    while s + 1 < head {
+        let k = s.min(head - 1 - s);
+        let (known, next) = out.split_at_mut(s + 1);
+        let two_as = 2.0 * known[s];
+        for ((x, &aj), &back) in next[..k]
+            .iter_mut()
+            .zip(&known[1..=k])
+            .zip(known[s - k..s].iter().rev())
+        {
+            *x = two_as * aj - back;
         }
-        m += 8;
+        s += k;
     }
-    for i in m..out.len() {
-        out[i] = two_a8 * out[i - 8] - r16 * out[i - 16];
+    // Forward in blocks of STRIDE: cos(m phi) = 2 cos(S phi) cos((m - S)
+    // phi) - cos((m - 2 S) phi), each block from the two before it.
+    let two_a = 2.0 * out[STRIDE.min(n - 1)];
+    let mut m = head;
+    while m < n {
+        let k = STRIDE.min(n - m);
+        let (done, next) = out.split_at_mut(m);
+        let (back2, back1) = done[m - 2 * STRIDE..].split_at(STRIDE);
+        for ((x, &b1), &b2) in next[..k].iter_mut().zip(back1).zip(back2) {
+            *x = two_a * b1 - b2;
+        }
+        m += k;
     }
-}
-
-/// `sum_m s_m t_m` per channel of a node pair's interleaved orders `row`
-/// (`K` channels per order) against `t` (at least as long), with eight
-/// partial sums per channel so that the additions do not form one chain.
-#[inline(always)]
-fn dot_orders<const K: usize>(row: &[f64], t: &[f64]) -> [f64; K] {
-    let mut s = [[0.0f64; K]; 8];
-    let whole = row.len() / (8 * K);
-    for (a8, t8) in row.chunks_exact(8 * K).zip(t.chunks_exact(8)) {
-        for q in 0..8 {
-            for k in 0..K {
-                s[q][k] += a8[q * K + k] * t8[q];
+    if r != 1.0 {
+        // r^m, eight powers at a time.
+        let mut p: [f64; 8] = std::array::from_fn(|q| r.powi(q as i32));
+        let r8 = r.powi(8);
+        for block in out.chunks_mut(8) {
+            for (x, pq) in block.iter_mut().zip(p.iter_mut()) {
+                *x *= *pq;
+                *pq *= r8;
             }
         }
     }
-    for (a, &tm) in row[whole * 8 * K..].chunks_exact(K).zip(&t[whole * 8..]) {
-        for k in 0..K {
-            s[0][k] += a[k] * tm;
+}
+
+/// Partial sums in [`dot_orders`]: sixteen, so that with AVX2 four chains of
+/// four lanes keep the multiply-adds' latency hidden (eight were the bound
+/// at grazing pairs: two orders per cycle whatever the vector width).
+const PARTIAL_SUMS: usize = 16;
+
+/// `Q` zeros then `Q` ones: `[rest..rest + Q]` masks the first `Q - rest`
+/// of a block ([`dot_orders`]' last one).
+static TAIL_MASK: [f64; 2 * PARTIAL_SUMS] = {
+    let mut m = [0.0; 2 * PARTIAL_SUMS];
+    let mut i = PARTIAL_SUMS;
+    while i < 2 * PARTIAL_SUMS {
+        m[i] = 1.0;
+        i += 1;
+    }
+    m
+};
+
+/// `a b + c`, fused when `FMA` (the caller was compiled for a CPU with
+/// fused multiply-add: [`fourier_sum`]'s clones); a multiply and an add
+/// otherwise, as `mul_add` without the instruction is a library call.
+#[inline(always)]
+fn madd<const FMA: bool>(a: f64, b: f64, c: f64) -> f64 {
+    if FMA {
+        a.mul_add(b, c)
+    } else {
+        a * b + c
+    }
+}
+
+/// `sum_m s_m t_m` of one channel's orders `row` against `t` (at least as
+/// long), with [`PARTIAL_SUMS`] partial sums so that the additions do not
+/// form one chain.
+#[inline(always)]
+fn dot_orders<const FMA: bool>(row: &[f64], t: &[f64]) -> f64 {
+    const Q: usize = PARTIAL_SUMS;
+    let mut s = [0.0f64; Q];
+    let whole = row.len() / Q;
+    for (a, tq) in row.chunks_exact(Q).zip(t.chunks_exact(Q)) {
+        for q in 0..Q {
+            s[q] = madd::<FMA>(a[q], tq[q], s[q]);
         }
     }
-    std::array::from_fn(|k| ((s[0][k] + s[1][k]) + (s[2][k] + s[3][k])) + ((s[4][k] + s[5][k]) + (s[6][k] + s[7][k])))
+    // The last orders as one more block across all the partial sums (one
+    // chain for them cost 4 cycles an order): the row's last Q orders with
+    // those already summed masked out, or, for a row shorter than a block,
+    // copied into one padded with zeros.
+    let rest = row.len() - whole * Q;
+    if rest > 0 && whole > 0 {
+        let from = row.len() - Q;
+        let (a, tq) = (&row[from..], &t[from..from + Q]);
+        let mask = &TAIL_MASK[rest..rest + Q];
+        for q in 0..Q {
+            s[q] = madd::<FMA>(a[q], tq[q] * mask[q], s[q]);
+        }
+    } else if rest > 0 {
+        let (mut a, mut tq) = ([0.0f64; Q], [0.0f64; Q]);
+        a[..rest].copy_from_slice(row);
+        tq[..rest].copy_from_slice(&t[..rest]);
+        for q in 0..Q {
+            s[q] = madd::<FMA>(a[q], tq[q], s[q]);
+        }
+    }
+    // Pairwise: Q -> Q / 2 -> ... -> 1.
+    let mut width = Q;
+    while width > 1 {
+        width /= 2;
+        for q in 0..width {
+            s[q] += s[q + width];
+        }
+    }
+    s[0]
 }
 
 /// The Fourier series `sum_m s_m cos(m phi)` (`c = cos phi`) of the three
 /// node pairs `pairs` of a table `tab` with `K` channels, weighted by
 /// `weights`: each pair over the orders it keeps, against `cos(m phi)`
-/// computed once for the longest ([`cos_series`], [`dot_orders`]).
-#[inline(always)]
+/// computed once for the longest ([`cos_series`], [`dot_orders`]). Compiled
+/// also for AVX2 with FMA and chosen at run time where the CPU has them
+/// (`multiversion`): grazing node pairs keep up to
+/// [`SlabOptions::walk_orders`] orders, and SSE2's two lanes with a
+/// separate multiply and add were the bound there.
+#[multiversion(targets("x86_64+avx2+fma"))]
 fn fourier_sum<const K: usize>(tab: &Tables, st: usize, pairs: [usize; 3], weights: [f64; 3], c: f64) -> [f64; K] {
+    const FMA: bool = target_cfg_f!(target_feature = "fma");
     let t = &tab.c[st >> 1][st & 1];
     let (start, len) = (&tab.start[st >> 1][st & 1], &tab.len[st >> 1][st & 1]);
     // The pairs that take part, with their weights and orders.
-    let rows = || {
-        pairs.iter().zip(&weights).filter(|(_, &w)| w != 0.0).map(|(&p, &w)| {
-            let from = start[p] as usize * K;
-            (w, &t[from..from + len[p] as usize * K])
-        })
-    };
-    let weighted = |series: &dyn Fn(&[f64]) -> [f64; K]| {
-        let mut acc = [0.0f64; K];
-        for (w, row) in rows() {
-            let s = series(row);
-            for k in 0..K {
-                acc[k] += w * s[k];
-            }
+    // (weight, the pair's K channels of `l` orders each, l)
+    let mut rows: [(f64, &[f64], usize); 3] = [(0.0, &[], 0); 3];
+    let (mut count, mut longest) = (0, 0);
+    for (&p, &w) in pairs.iter().zip(&weights) {
+        if w != 0.0 {
+            let (from, l) = (start[p] as usize * K, len[p] as usize);
+            rows[count] = (w, &t[from..from + l * K], l);
+            longest = longest.max(l);
+            count += 1;
         }
-        acc
-    };
-    let longest = rows().map(|(_, row)| row.len() / K).max().unwrap_or(0);
-    let buffered = |cos_m: &mut [f64]| {
-        cos_series(&mut cos_m[..longest], c, 1.0);
-        weighted(&|row| dot_orders::<K>(row, cos_m))
-    };
-    // Most pairs keep a few orders: one recurrence per pair is cheapest
-    // there (no buffer to clear); above, a buffer no longer than needed.
-    match longest {
-        l if l <= SHORT_SERIES => weighted(&|row| {
+    }
+    let rows = &rows[..count];
+    let mut acc = [0.0f64; K];
+    if longest <= SHORT_SERIES {
+        // Most pairs keep a few orders: one recurrence per pair is cheapest
+        // there (no buffer to fill).
+        for &(w, row, l) in rows {
             let mut s = [0.0f64; K];
             let (mut c_prev, mut c_m) = (c, 1.0);
-            for a in row.chunks_exact(K) {
+            for m in 0..l {
                 for k in 0..K {
-                    s[k] += a[k] * c_m;
+                    s[k] += row[k * l + m] * c_m;
                 }
                 let next = 2.0 * c * c_m - c_prev;
                 c_prev = c_m;
                 c_m = next;
             }
-            s
-        }),
-        _ => with_series_buffer(longest, buffered),
+            for k in 0..K {
+                acc[k] += w * s[k];
+            }
+        }
+        return acc;
     }
+    with_series_buffer(longest, |cos_m| {
+        cos_series(&mut cos_m[..longest], c, 1.0);
+        for &(w, row, l) in rows {
+            for (a, channel) in acc.iter_mut().zip(row.chunks_exact(l)) {
+                *a += w * dot_orders::<FMA>(channel, cos_m);
+            }
+        }
+        acc
+    })
 }
 
 /// Runs `f` on a zeroed buffer for a series of `len` orders (at most
@@ -1335,7 +1421,7 @@ fn fourier_sum_pole<const K: usize>(
     let mut acc = [0.0f64; K];
     for (&p, &w) in pairs.iter().zip(&weights) {
         for (k, a) in acc.iter_mut().enumerate() {
-            *a += w * t[start[p] as usize * K + k];
+            *a += w * t[start[p] as usize * K + k * len[p] as usize];
         }
     }
     let longest = pole
@@ -1352,11 +1438,9 @@ fn fourier_sum_pole<const K: usize>(
             if w == 0.0 || len[p] < 2 {
                 continue;
             }
-            let from = (start[p] as usize + 1) * K;
-            let row = &t[from..from + (len[p] as usize - 1) * K];
-            let s = dot_orders::<K>(row, &a_m[1..longest]);
-            for (k, x) in acc.iter_mut().enumerate() {
-                *x += w * s[k];
+            let (from, l) = (start[p] as usize * K, len[p] as usize);
+            for (x, channel) in acc.iter_mut().zip(t[from..from + l * K].chunks_exact(l)) {
+                *x += w * dot_orders::<false>(&channel[1..], &a_m[1..longest]);
             }
         }
         acc
@@ -2369,18 +2453,18 @@ mod tests {
     }
 
     /// `cos_series` against `r^m cos(m phi)` computed directly, at every
-    /// length around its switch from the one-step to the eight-step
-    /// recurrence and at the longest series, for azimuths where the
+    /// length through its first five doublings, around the later ones and
+    /// at the longest series, for azimuths where the
     /// recurrences are least stable (`phi` near 0, `pi / 8`, `pi / 2`, `pi`)
     /// and damping `r` of the pole's orders; and `dot_orders` against the
-    /// plain sum, for every remainder of its blocks and both channel counts.
+    /// plain sum, for every remainder of its blocks, fused or not.
     #[test]
     fn cos_series_is_the_cosines() {
         let mut worst = 0.0f64;
         for phi in [0.0, 1e-7, 0.3, PI / 8.0, 1.0, PI / 2.0 - 1e-9, 2.5, PI - 1e-6, PI] {
             let c = f64::cos(phi);
             for r in [1.0f64, 0.93, 0.5, 0.0] {
-                for len in (0..=40).chain([255, 256, 257, MAX_ORDERS]) {
+                for len in (0..=40).chain([63, 64, 65, 127, 128, 129, 255, 256, 257, MAX_ORDERS]) {
                     let mut out = vec![f64::NAN; len];
                     cos_series(&mut out, c, r);
                     for (m, &v) in out.iter().enumerate() {
@@ -2395,21 +2479,13 @@ mod tests {
             }
         }
         eprintln!("cos_series: largest error {worst:.1e}");
-        for len in 0..40 {
+        for len in (0..70).chain([255, 256, 257]) {
             let t: Vec<f64> = (0..len).map(|m| (m as f64 * 0.37).cos()).collect();
-            let row3: Vec<f64> = (0..3 * len).map(|i| ((i * 7919) % 101) as f64 / 101.0 - 0.3).collect();
-            let got = dot_orders::<3>(&row3, &t);
-            for k in 0..3 {
-                let want: f64 = (0..len).map(|m| row3[3 * m + k] * t[m]).sum();
-                assert!(
-                    (got[k] - want).abs() < 1e-12,
-                    "len {len} channel {k}: {} vs {want}",
-                    got[k]
-                );
+            let row: Vec<f64> = (0..len).map(|i| ((i * 7919) % 101) as f64 / 101.0 - 0.3).collect();
+            let want: f64 = row.iter().zip(&t).map(|(a, b)| a * b).sum();
+            for got in [dot_orders::<false>(&row, &t), dot_orders::<true>(&row, &t)] {
+                assert!((got - want).abs() < 1e-12, "len {len}: {got} vs {want}");
             }
-            let got = dot_orders::<1>(&row3[..len], &t);
-            let want: f64 = (0..len).map(|m| row3[m] * t[m]).sum();
-            assert!((got[0] - want).abs() < 1e-12, "len {len}: {} vs {want}", got[0]);
         }
     }
 
