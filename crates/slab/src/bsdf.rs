@@ -274,21 +274,30 @@ impl SmoothSheet {
 /// the number of orders that matter for each node pair.
 #[derive(Clone, Debug, Default)]
 struct Tables {
-    /// Channel `k` of `c_m[o][j]` at `start[p] K + k len[p] + m`, `p = o n +
-    /// j`, `m < len[p]`, with `K` = [`Tables::channels`]: each pair stores
-    /// only the orders it keeps (the walk's reflection at grazing incidence
-    /// needs up to [`SlabOptions::walk_orders`], most pairs a few), a
-    /// channel's orders contiguous (one vectorised sum per channel; with
-    /// the channels interleaved, as until 2026-12-06, three-channel sheets
-    /// could not use four lanes).
+    /// Per pair `p = o n + j`, from `start[p]`: channel `k` of `c_m[o][j]`
+    /// at `k h + m` for `m < h = head[p]`, with `K` = [`Tables::channels`];
+    /// then, if `len[p] > h` (a shared tail), channel 0's orders `h..len` and
+    /// the ratios of channels `1..K` to channel 0 over them (`K - 1`
+    /// values). Each pair stores only the orders it keeps (the walk's
+    /// reflection at grazing incidence needs up to
+    /// [`SlabOptions::walk_orders`], most pairs a few), a channel's orders
+    /// contiguous (one vectorised sum per channel; with the channels
+    /// interleaved, as until 2026-12-06, three-channel sheets could not use
+    /// four lanes).
     c: [[Vec<f64>; 2]; 2],
     /// Per pair `p = o n + j`: the orders `0..len` kept, the fewest whose
     /// dropped tail sums to at most [`ORDER_CUTOFF`] of the pair's largest
     /// coefficient (the same for a pair and its reciprocal, so truncation
     /// keeps reciprocity exact).
     len: [[Vec<u16>; 2]; 2],
-    /// Per pair: where its orders start in `c`, in orders (`c` index / `K`).
+    /// Per pair: where its values start in `c`.
     start: [[Vec<u32>; 2]; 2],
+    /// Per pair: the orders stored per channel, `len` unless the orders
+    /// from the solution's on (the walk's reflection past
+    /// [`SlabOptions::orders`], whose channels differ only by the balance
+    /// factors: [`shared_tail`]) are stored once with the channels' ratios,
+    /// so that a three-channel sheet sums them once.
+    head: [[Vec<u16>; 2]; 2],
     /// Channels stored: 1 for a grey sheet (every colour channel has the
     /// same medium, so one solve and equal tables: `eval` sums one series
     /// instead of three), else 3.
@@ -307,10 +316,24 @@ const ORDER_CUTOFF: f64 = 1e-5;
 const TINY: f64 = 1e-200;
 
 impl Tables {
+    /// Pair `p` of table `st` (`2 side + transmit`) with `K` channels: its
+    /// values in `c`, the orders it keeps and the orders stored per channel
+    /// ([`Tables::c`]).
+    #[inline(always)]
+    fn pair<const K: usize>(&self, st: usize, p: usize) -> (&[f64], usize, usize) {
+        let (s, t) = (st >> 1, st & 1);
+        let (l, h) = (self.len[s][t][p] as usize, self.head[s][t][p] as usize);
+        let size = if l > h { K * h + l - h + K - 1 } else { K * h };
+        let from = self.start[s][t][p] as usize;
+        (&self.c[s][t][from..from + size], l, h)
+    }
+
     /// Truncates the orders of every node pair (`n` nodes; `orders[side][transmit]`
     /// orders per pair in `c`), packs each pair's kept orders ([`Tables::start`])
-    /// and stores channel 0 alone when `grey` (all channels equal).
-    fn truncate(c: [[Vec<Rgb>; 2]; 2], n: usize, orders: [[usize; 2]; 2], grey: bool) -> Tables {
+    /// and stores channel 0 alone when `grey` (all channels equal); the
+    /// orders from `shared_from` (the solution's count) on once, with the
+    /// channels' ratios, where they are proportional ([`shared_tail`]).
+    fn truncate(c: [[Vec<Rgb>; 2]; 2], n: usize, orders: [[usize; 2]; 2], grey: bool, shared_from: usize) -> Tables {
         let mut c = c;
         let mut len: [[Vec<u16>; 2]; 2] = Default::default();
         for tab in c.iter_mut().flatten() {
@@ -358,16 +381,27 @@ impl Tables {
         }
         let channels = if grey { 1 } else { 3 };
         let mut start: [[Vec<u32>; 2]; 2] = Default::default();
+        let mut head: [[Vec<u16>; 2]; 2] = Default::default();
         let c = std::array::from_fn(|s| {
             std::array::from_fn(|t| {
                 let mut packed = Vec::new();
-                let mut at = 0u32;
                 let orders = orders[s][t];
                 for (p, &l) in sym[s][t].iter().enumerate() {
-                    start[s][t].push(at);
-                    at += u32::from(l);
+                    let coef = &c[s][t][p * orders..p * orders + l as usize];
+                    start[s][t].push(packed.len() as u32);
+                    // A shared tail only past the short series (summed per
+                    // pair by its own recurrence, `fourier_sum`).
+                    let ratios = (channels == 3 && coef.len() > shared_from.max(SHORT_SERIES))
+                        .then(|| shared_tail(&coef[shared_from..]))
+                        .flatten();
+                    let h = if ratios.is_some() { shared_from } else { coef.len() };
+                    head[s][t].push(h as u16);
                     for k in 0..channels {
-                        packed.extend(c[s][t][p * orders..p * orders + l as usize].iter().map(|v| v.0[k]));
+                        packed.extend(coef[..h].iter().map(|v| v.0[k]));
+                    }
+                    if let Some(r) = ratios {
+                        packed.extend(coef[h..].iter().map(|v| v.0[0]));
+                        packed.extend(r);
                     }
                 }
                 packed
@@ -377,9 +411,37 @@ impl Tables {
             c,
             len: sym,
             start,
+            head,
             channels,
         }
     }
+}
+
+/// Relative size below which a shared tail's channels count as proportional
+/// ([`shared_tail`]): rounding (the walk's orders are one solution times
+/// per-channel balance factors, so proportional but for it).
+const SHARED_TOLERANCE: f64 = 1e-12;
+
+/// The ratios of channels 1 and 2 to channel 0 over a pair's orders `tail`
+/// if every order is channel 0's times them (within [`SHARED_TOLERANCE`]
+/// of the tail's largest coefficient), else `None`.
+fn shared_tail(tail: &[Rgb]) -> Option<[f64; 2]> {
+    let (mut dot, mut norm) = ([0.0f64; 2], 0.0f64);
+    let mut big = 0.0f64;
+    for v in tail {
+        norm += v.0[0] * v.0[0];
+        for (d, x) in dot.iter_mut().zip(&v.0[1..]) {
+            *d += x * v.0[0];
+        }
+        big = v.0.iter().fold(big, |a, x| a.max(x.abs()));
+    }
+    if norm == 0.0 {
+        return None;
+    }
+    let r = dot.map(|d| d / norm);
+    tail.iter()
+        .all(|v| (0..2).all(|k| (v.0[k + 1] - r[k] * v.0[0]).abs() <= SHARED_TOLERANCE * big))
+        .then_some(r)
 }
 
 /// The sampling density of the table for one node of `wo` (module doc).
@@ -1337,16 +1399,14 @@ fn dot_orders<const FMA: bool>(row: &[f64], t: &[f64]) -> f64 {
 #[multiversion(targets("x86_64+avx2+fma"))]
 fn fourier_sum<const K: usize>(tab: &Tables, st: usize, pairs: [usize; 3], weights: [f64; 3], c: f64) -> [f64; K] {
     const FMA: bool = target_cfg_f!(target_feature = "fma");
-    let t = &tab.c[st >> 1][st & 1];
-    let (start, len) = (&tab.start[st >> 1][st & 1], &tab.len[st >> 1][st & 1]);
-    // The pairs that take part, with their weights and orders.
-    // (weight, the pair's K channels of `l` orders each, l)
-    let mut rows: [(f64, &[f64], usize); 3] = [(0.0, &[], 0); 3];
+    // The pairs that take part: (weight, the pair's values, orders kept,
+    // orders per channel).
+    let mut rows: [(f64, &[f64], usize, usize); 3] = [(0.0, &[], 0, 0); 3];
     let (mut count, mut longest) = (0, 0);
     for (&p, &w) in pairs.iter().zip(&weights) {
         if w != 0.0 {
-            let (from, l) = (start[p] as usize * K, len[p] as usize);
-            rows[count] = (w, &t[from..from + l * K], l);
+            let (data, l, h) = tab.pair::<K>(st, p);
+            rows[count] = (w, data, l, h);
             longest = longest.max(l);
             count += 1;
         }
@@ -1356,7 +1416,7 @@ fn fourier_sum<const K: usize>(tab: &Tables, st: usize, pairs: [usize; 3], weigh
     if longest <= SHORT_SERIES {
         // Most pairs keep a few orders: one recurrence per pair is cheapest
         // there (no buffer to fill).
-        for &(w, row, l) in rows {
+        for &(w, row, l, _) in rows {
             let mut s = [0.0f64; K];
             let (mut c_prev, mut c_m) = (c, 1.0);
             for m in 0..l {
@@ -1375,9 +1435,16 @@ fn fourier_sum<const K: usize>(tab: &Tables, st: usize, pairs: [usize; 3], weigh
     }
     with_series_buffer(longest, |cos_m| {
         cos_series(&mut cos_m[..longest], c, 1.0);
-        for &(w, row, l) in rows {
-            for (a, channel) in acc.iter_mut().zip(row.chunks_exact(l)) {
+        for &(w, data, l, h) in rows {
+            for (a, channel) in acc.iter_mut().zip(data.chunks_exact(h)) {
                 *a += w * dot_orders::<FMA>(channel, cos_m);
+            }
+            if l > h {
+                let tail = dot_orders::<FMA>(&data[K * h..K * h + l - h], &cos_m[h..]);
+                acc[0] += w * tail;
+                for (a, r) in acc[1..].iter_mut().zip(&data[K * h + l - h..]) {
+                    *a += w * r * tail;
+                }
             }
         }
         acc
@@ -1416,12 +1483,11 @@ fn fourier_sum_pole<const K: usize>(
     pole: &PoleCorners,
     c: f64,
 ) -> [f64; K] {
-    let t = &tab.c[st >> 1][st & 1];
-    let (start, len) = (&tab.start[st >> 1][st & 1], &tab.len[st >> 1][st & 1]);
     let mut acc = [0.0f64; K];
     for (&p, &w) in pairs.iter().zip(&weights) {
+        let (data, _, h) = tab.pair::<K>(st, p);
         for (k, a) in acc.iter_mut().enumerate() {
-            *a += w * t[start[p] as usize * K + k * len[p] as usize];
+            *a += w * data[k * h];
         }
     }
     let longest = pole
@@ -1429,18 +1495,25 @@ fn fourier_sum_pole<const K: usize>(
         .iter()
         .zip(&pole.weights)
         .filter(|(_, &w)| w != 0.0)
-        .map(|(&p, _)| len[p] as usize)
+        .map(|(&p, _)| tab.pair::<K>(st, p).1)
         .max()
         .unwrap_or(0);
     with_series_buffer(longest, |a_m| {
         cos_series(&mut a_m[..longest], c, pole.r);
         for (&p, &w) in pole.pairs.iter().zip(&pole.weights) {
-            if w == 0.0 || len[p] < 2 {
+            let (data, l, h) = tab.pair::<K>(st, p);
+            if w == 0.0 || l < 2 {
                 continue;
             }
-            let (from, l) = (start[p] as usize * K, len[p] as usize);
-            for (x, channel) in acc.iter_mut().zip(t[from..from + l * K].chunks_exact(l)) {
+            for (x, channel) in acc.iter_mut().zip(data.chunks_exact(h)) {
                 *x += w * dot_orders::<false>(&channel[1..], &a_m[1..longest]);
+            }
+            if l > h {
+                let tail = dot_orders::<false>(&data[K * h..K * h + l - h], &a_m[h..longest]);
+                acc[0] += w * tail;
+                for (x, r) in acc[1..].iter_mut().zip(&data[K * h + l - h..]) {
+                    *x += w * r * tail;
+                }
             }
         }
         acc
@@ -1873,8 +1946,8 @@ impl SlabBsdf {
         let q: Vec<f64> = (0..n).map(|o| 2.0 * PI * g.w[o] * g.mu[o]).collect();
         fejer_where_ringing(&mut table, &mut direct, &q, orders, m_solved, if grey { 1 } else { 3 });
         let (table, direct) = (
-            Tables::truncate(table, n, orders, grey),
-            Tables::truncate(direct, n, orders, grey),
+            Tables::truncate(table, n, orders, grey, m_solved),
+            Tables::truncate(direct, n, orders, grey, m_solved),
         );
         let smooth = both_smooth.then(|| SmoothSheet {
             eta_f: specs[0].front.eta(),
@@ -2080,6 +2153,7 @@ impl SlabBsdf {
                     .sum::<usize>()
                     + t.len.iter().flatten().map(|v| v.len() * 2).sum::<usize>()
                     + t.start.iter().flatten().map(|v| v.len() * 4).sum::<usize>()
+                    + t.head.iter().flatten().map(|v| v.len() * 2).sum::<usize>()
             })
             .sum();
         let cells: usize = self
@@ -2379,7 +2453,8 @@ impl ComponentModel for SlabBsdf {
 #[cfg(test)]
 mod tests {
     use super::{
-        cos_series, dot_orders, locate, ridge_ratios, shape_at, triangle_weights, CellDensity, MAX_ORDERS, SHAPE_STEPS,
+        cos_series, dot_orders, fourier_sum, fourier_sum_pole, locate, ridge_ratios, shape_at, triangle_weights,
+        CellDensity, PoleCorners, Tables, MAX_ORDERS, SHAPE_STEPS,
     };
     use paperbsdf_core::Rgb;
     use std::f64::consts::PI;
@@ -2487,6 +2562,82 @@ mod tests {
                 assert!((got - want).abs() < 1e-12, "len {len}: {got} vs {want}");
             }
         }
+    }
+
+    /// Three-channel tables whose orders from the solution's on are stored
+    /// once with the channels' ratios (`Tables::truncate`, `shared_tail`)
+    /// sum to what the same tables stored per channel sum to, in
+    /// `fourier_sum` and near the pole in `fourier_sum_pole`, at pairs with
+    /// and without a tail, long and short; a tail that is not proportional
+    /// (one coefficient off by 1e-9 of the largest) is stored per channel.
+    #[test]
+    fn shared_tails_sum_as_the_channels() {
+        let (n, orders, from) = (4usize, 96usize, 24usize);
+        let coef = |p: usize, m: usize| -> Rgb {
+            let e = (1.0 + p as f64) * 0.97f64.powi(m as i32) * (1.0 + 0.3 * (m as f64 * 0.7).sin());
+            if m < from {
+                Rgb([e, 0.5 * e + 0.01 * (m as f64).cos(), 0.2 * e - 0.003 * m as f64])
+            } else {
+                // Channels 1 and 2 in proportion, the ratios differing by pair.
+                Rgb([e, (0.8 + 0.05 * p as f64) * e, 0.35 * e])
+            }
+        };
+        let make = |long: fn(usize) -> bool| -> Vec<Rgb> {
+            (0..n * n)
+                .flat_map(|p| (0..orders).map(move |m| if m < 12 || long(p) { coef(p, m) } else { Rgb::ZERO }))
+                .collect()
+        };
+        // Reflection keeps up to 96 orders at pairs p % 3 == 0 (a set closed
+        // under transposition), 12 elsewhere; transmission 12 everywhere
+        // (below the shared start: no tail).
+        let c = [0, 1].map(|_| [make(|p| p % 3 == 0), make(|_| false)]);
+        let shared = Tables::truncate(c.clone(), n, [[orders; 2]; 2], false, from);
+        let plain = Tables::truncate(c.clone(), n, [[orders; 2]; 2], false, usize::MAX / 2);
+        assert!(
+            shared.head[0][0].iter().any(|&h| h as usize == from),
+            "no pair shares its tail"
+        );
+        assert!(plain.head[0][0].iter().zip(&plain.len[0][0]).all(|(h, l)| h == l));
+        for st in 0..4 {
+            for pairs in [[0, 1, 5], [3, 6, 9], [15, 12, 0], [7, 10, 13]] {
+                for cphi in [1.0, 0.9, 0.1, -0.5, -1.0] {
+                    let weights = [0.2, 0.5, 0.3];
+                    let (a, b) = (
+                        fourier_sum::<3>(&shared, st, pairs, weights, cphi),
+                        fourier_sum::<3>(&plain, st, pairs, weights, cphi),
+                    );
+                    let pole = PoleCorners {
+                        pairs: [pairs[0], pairs[1]],
+                        weights: [0.4, 0.6],
+                        r: 0.8,
+                    };
+                    let (pa, pb) = (
+                        fourier_sum_pole::<3>(&shared, st, pairs, weights, &pole, cphi),
+                        fourier_sum_pole::<3>(&plain, st, pairs, weights, &pole, cphi),
+                    );
+                    for k in 0..3 {
+                        assert!(
+                            (a[k] - b[k]).abs() <= 1e-12 * b[k].abs().max(1.0),
+                            "st {st} {pairs:?} c {cphi} k {k}: {} vs {}",
+                            a[k],
+                            b[k]
+                        );
+                        assert!(
+                            (pa[k] - pb[k]).abs() <= 1e-12 * pb[k].abs().max(1.0),
+                            "pole st {st} {pairs:?} c {cphi} k {k}: {} vs {}",
+                            pa[k],
+                            pb[k]
+                        );
+                    }
+                }
+            }
+        }
+        // Not proportional: stored per channel.
+        let mut off = c;
+        let big = off[0][0][..orders].iter().map(|v| v.0[0]).fold(0.0, f64::max);
+        off[0][0][from + 5].0[2] += 1e-9 * big;
+        let t = Tables::truncate(off, n, [[orders; 2]; 2], false, from);
+        assert_eq!(t.head[0][0][0], t.len[0][0][0], "a tail off by 1e-9 was shared");
     }
 
     /// The guided search finds the cell a binary search finds, for every

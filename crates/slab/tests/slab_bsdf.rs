@@ -560,8 +560,12 @@ fn components_sum_to_eval() {
 /// both sides, equals channel 0 of the same sheet with a different
 /// absorption in channels 1 and 2 (three channels stored, channel 0 the same
 /// medium and solve), at grazing, near-normal and off-node directions, in
-/// reflection and transmission. Both compute channel 0 with the same
-/// operations in the same order, so they agree to rounding.
+/// reflection and transmission. They agree to rounding: the same operations,
+/// except that the RGB sheet sums the walk's orders past the solution's apart
+/// from the orders below (stored once for its three channels,
+/// `Tables::head`), a different grouping of the same sum, so the tolerance
+/// has an absolute floor of 1e-15 (1e-12 of 1e-3; the coefficients are of
+/// order 1e-3 to 10, and a component near 1e-8 moved by 1e-10 of itself).
 #[test]
 fn grey_sheet_is_the_rgb_sheet_channel() {
     let grey = preset("luster").unwrap();
@@ -581,13 +585,13 @@ fn grey_sheet_is_the_rgb_sheet_channel() {
                 let want = c.eval(wi, wo).0[0];
                 let got = g.eval(wi, wo);
                 assert!(
-                    (got.0[0] - want).abs() <= 1e-12 * want.abs().max(1e-12),
+                    (got.0[0] - want).abs() <= 1e-12 * want.abs().max(1e-3),
                     "eval({ti},{pi},{si} -> {to},{po},{so}): grey {got:?}, rgb channel 0 {want}"
                 );
                 assert!(got.0[0] == got.0[1] && got.0[1] == got.0[2], "grey eval {got:?}");
                 for &k in g.components() {
                     let (a, b) = (g.eval_component(wi, wo, k).0[0], c.eval_component(wi, wo, k).0[0]);
-                    assert!((a - b).abs() <= 1e-12 * b.abs().max(1e-12), "{k:?}: {a} vs {b}");
+                    assert!((a - b).abs() <= 1e-12 * b.abs().max(1e-3), "{k:?}: {a} vs {b}");
                 }
                 n += 1;
             }
