@@ -282,7 +282,7 @@ struct Tables {
     /// reflection at grazing incidence needs up to
     /// [`SlabOptions::walk_orders`], most pairs a few), a channel's orders
     /// contiguous (one vectorised sum per channel; with the channels
-    /// interleaved, as until 2026-12-06, three-channel sheets could not use
+    /// interleaved, as until 2026-12-05, three-channel sheets could not use
     /// four lanes).
     c: [[Vec<f64>; 2]; 2],
     /// Per pair `p = o n + j`: the orders `0..len` kept, the fewest whose
@@ -1249,19 +1249,20 @@ fn fejer_where_ringing(
 }
 
 /// `a_m = r^m cos(m phi)` for `m = 0..out.len()` (`c = cos phi`, `0 <= r <=
-/// 1`), by doubling: from `cos 0 = 1`, `cos phi = c` and the cosines up to
-/// `s phi`, the next `s` at once by the product formula `cos((s+j) phi) =
-/// 2 cos(s phi) cos(j phi) - cos((s-j) phi)`,
-/// so `s` = 1, 2, 4, ... and 256 orders take eight steps, each one
-/// vectorised loop without a chain through its values; for `r < 1` (the
-/// pole's orders, [`fourier_sum_pole`]) the cosines are then multiplied by
-/// `r^m`, eight powers at a time. Until 2026-12-06 a recurrence stepped eight orders at
-/// a time (eight chains; one chain per node pair before 2026-12-05): its
-/// chain through the stored values was about half of `eval` at grazing
-/// pairs, which keep up to [`SlabOptions::walk_orders`] orders (a perf
-/// profile; criterion benches/slab.rs `eval_grazing`). Rounding grows like
-/// `m eps` per doubling at worst (`cos_series_is_the_cosines` checks it
-/// against `cos` directly: below 1e-11 at [`MAX_ORDERS`]).
+/// 1`). The first 64 by doubling: from `cos 0 = 1`, `cos phi = c` and the
+/// cosines up to `s phi`, the next `s` at once by the product formula
+/// `cos((s+j) phi) = 2 cos(s phi) cos(j phi) - cos((s-j) phi)`, `s` = 1, 2,
+/// 4, ..., 32; the rest forward, 32 at a time, by `cos(m phi) = 2 cos(32
+/// phi) cos((m-32) phi) - cos((m-64) phi)`, each block from the two stored
+/// before it (the doubling to the end read its values backwards, a
+/// shuffle per four). For `r < 1` (the pole's orders, [`fourier_sum_pole`])
+/// the cosines are then multiplied by `r^m`, eight powers at a time. Until
+/// 2026-12-05 a recurrence stepped eight orders at a time (eight chains;
+/// one chain per node pair before that): its chain through the values it
+/// had just stored was about half of `eval` at grazing pairs, which keep up
+/// to [`SlabOptions::walk_orders`] orders (perf; criterion benches/slab.rs
+/// `eval_grazing`). Rounding: 1.3e-13 at most against `cos` directly, to
+/// [`MAX_ORDERS`] (`cos_series_is_the_cosines`, which asks 1e-11).
 #[inline(always)]
 fn cos_series(out: &mut [f64], c: f64, r: f64) {
     const STRIDE: usize = 32;

@@ -86,10 +86,11 @@
 //! slowest; the dense solves' triangular substitutions are blocked,
 //! `linalg`, which made up for the edges' 35 ms per face). `eval` at grazing
 //! angles near the mirror direction, where node pairs keep up to 256
-//! orders (the walk's forward peak), takes 280-720 ns (benches/slab.rs
-//! `eval_grazing`; 1.0-1.95 us before the sum's shared cosines and partial
-//! sums, [`bsdf`]), above the 200 ns; mid angles 50-110 ns, `sample`
-//! 252-277 ns. Near `eta_f = eta_b` from
+//! orders (the walk's forward peak), takes 183-305 ns with AVX2 and FMA
+//! (benches/slab.rs `eval_grazing`; the Fourier sum is compiled for them
+//! and chosen at run time, [`bsdf`]; 280-720 ns before, 1.0-1.95 us before
+//! the sum's shared cosines), above the 200 ns but for thin
+//! tissue; mid angles 49-93 ns, `sample` 255-281 ns. Near `eta_f = eta_b` from
 //! below (the base denser) the discretisation moves with the boundary's
 //! critical cosine, by `O(sqrt(eta_b - eta_f))` (8e-5 in the totals at a
 //! difference of 1e-6; tests/coated.rs).
