@@ -1400,6 +1400,19 @@ fn dot_orders<const FMA: bool>(row: &[f64], t: &[f64]) -> f64 {
 #[multiversion(targets("x86_64+avx2+fma"))]
 fn fourier_sum<const K: usize>(tab: &Tables, st: usize, pairs: [usize; 3], weights: [f64; 3], c: f64) -> [f64; K] {
     const FMA: bool = target_cfg_f!(target_feature = "fma");
+    fourier_sum_with::<K, FMA>(tab, st, pairs, weights, c)
+}
+
+/// [`fourier_sum`]'s body, its multiply-adds fused when `FMA` (callable
+/// with either, so that a test compares the two paths on any CPU).
+#[inline(always)]
+fn fourier_sum_with<const K: usize, const FMA: bool>(
+    tab: &Tables,
+    st: usize,
+    pairs: [usize; 3],
+    weights: [f64; 3],
+    c: f64,
+) -> [f64; K] {
     // The pairs that take part: (weight, the pair's values, orders kept,
     // orders per channel).
     let mut rows: [(f64, &[f64], usize, usize); 3] = [(0.0, &[], 0, 0); 3];
@@ -2454,8 +2467,8 @@ impl ComponentModel for SlabBsdf {
 #[cfg(test)]
 mod tests {
     use super::{
-        cos_series, dot_orders, fourier_sum, fourier_sum_pole, locate, ridge_ratios, shape_at, triangle_weights,
-        CellDensity, PoleCorners, Tables, MAX_ORDERS, SHAPE_STEPS,
+        cos_series, dot_orders, fourier_sum, fourier_sum_pole, fourier_sum_with, locate, ridge_ratios, shape_at,
+        triangle_weights, CellDensity, PoleCorners, Tables, MAX_ORDERS, SHAPE_STEPS,
     };
     use paperbsdf_core::Rgb;
     use std::f64::consts::PI;
@@ -2569,7 +2582,9 @@ mod tests {
     /// once with the channels' ratios (`Tables::truncate`, `shared_tail`)
     /// sum to what the same tables stored per channel sum to, in
     /// `fourier_sum` and near the pole in `fourier_sum_pole`, at pairs with
-    /// and without a tail, long and short; a tail that is not proportional
+    /// and without a tail, long and short, with and without fused
+    /// multiply-adds (both paths of the run-time choice; also for one
+    /// channel); a tail that is not proportional
     /// (one coefficient off by 1e-9 of the largest) is stored per channel.
     #[test]
     fn shared_tails_sum_as_the_channels() {
@@ -2594,6 +2609,7 @@ mod tests {
         let c = [0, 1].map(|_| [make(|p| p % 3 == 0), make(|_| false)]);
         let shared = Tables::truncate(c.clone(), n, [[orders; 2]; 2], false, from);
         let plain = Tables::truncate(c.clone(), n, [[orders; 2]; 2], false, usize::MAX / 2);
+        let plain_grey = Tables::truncate(c.clone(), n, [[orders; 2]; 2], true, from);
         assert!(
             shared.head[0][0].iter().any(|&h| h as usize == from),
             "no pair shares its tail"
@@ -2607,6 +2623,22 @@ mod tests {
                         fourier_sum::<3>(&shared, st, pairs, weights, cphi),
                         fourier_sum::<3>(&plain, st, pairs, weights, cphi),
                     );
+                    // Both paths of the run-time choice, whatever this CPU has.
+                    for fused in [
+                        fourier_sum_with::<3, true>(&shared, st, pairs, weights, cphi),
+                        fourier_sum_with::<3, false>(&shared, st, pairs, weights, cphi),
+                    ] {
+                        for k in 0..3 {
+                            assert!((fused[k] - b[k]).abs() <= 1e-12 * b[k].abs().max(1.0));
+                        }
+                    }
+                    let want = fourier_sum::<1>(&plain_grey, st, pairs, weights, cphi)[0];
+                    for g in [
+                        fourier_sum_with::<1, true>(&plain_grey, st, pairs, weights, cphi)[0],
+                        fourier_sum_with::<1, false>(&plain_grey, st, pairs, weights, cphi)[0],
+                    ] {
+                        assert!((g - want).abs() <= 1e-12 * want.abs().max(1.0), "grey {g} vs {want}");
+                    }
                     let pole = PoleCorners {
                         pairs: [pairs[0], pairs[1]],
                         weights: [0.4, 0.6],
