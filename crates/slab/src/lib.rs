@@ -90,7 +90,7 @@
 //! (benches/slab.rs `eval_grazing`; the Fourier sum is compiled for them
 //! and chosen at run time, [`bsdf`]; 280-720 ns before, 1.0-1.95 us before
 //! the sum's shared cosines), above the 200 ns but for thin
-//! tissue; mid angles 49-93 ns, `sample` 255-281 ns. Near `eta_f = eta_b` from
+//! tissue; mid angles 49-108 ns, `sample` 255-281 ns. Near `eta_f = eta_b` from
 //! below (the base denser) the discretisation moves with the boundary's
 //! critical cosine, by `O(sqrt(eta_b - eta_f))` (8e-5 in the totals at a
 //! difference of 1e-6; tests/coated.rs).
