@@ -1430,7 +1430,9 @@ fn fourier_sum_with<const K: usize, const FMA: bool>(
     if longest <= SHORT_SERIES {
         // Most pairs keep a few orders: one recurrence per pair is cheapest
         // there (no buffer to fill).
-        for &(w, row, l, _) in rows {
+        for &(w, row, l, h) in rows {
+            // No shared tail this short (`Tables::truncate`).
+            debug_assert_eq!(l, h);
             let mut s = [0.0f64; K];
             let (mut c_prev, mut c_m) = (c, 1.0);
             for m in 0..l {
@@ -1472,18 +1474,33 @@ fn series_sum<const K: usize, const FMA: bool>(
     cos_series(cos_m, c, 1.0);
     let mut acc = [0.0f64; K];
     for &(w, data, l, h) in rows {
-        for (a, channel) in acc.iter_mut().zip(data.chunks_exact(h)) {
-            *a += w * dot_orders::<FMA>(channel, cos_m);
-        }
-        if l > h {
-            let tail = dot_orders::<FMA>(&data[K * h..K * h + l - h], &cos_m[h..]);
-            acc[0] += w * tail;
-            for (a, r) in acc[1..].iter_mut().zip(&data[K * h + l - h..]) {
-                *a += w * r * tail;
-            }
+        let s = pair_series::<K, FMA>(data, l, h, cos_m, 0);
+        for (a, x) in acc.iter_mut().zip(s) {
+            *a += w * x;
         }
     }
     acc
+}
+
+/// A node pair's series per channel ([`Tables::pair`]: its values `data`,
+/// `l` orders kept, `h` per channel, then a shared tail with the channels'
+/// ratios) against `t_m` (`r^m cos(m phi)`, at least `l` long), over the
+/// orders from `first` on (1 near the pole, whose order 0 is the
+/// triangles').
+#[inline(always)]
+fn pair_series<const K: usize, const FMA: bool>(data: &[f64], l: usize, h: usize, t: &[f64], first: usize) -> [f64; K] {
+    let mut s = [0.0f64; K];
+    for (x, channel) in s.iter_mut().zip(data.chunks_exact(h)) {
+        *x = dot_orders::<FMA>(&channel[first..], &t[first..]);
+    }
+    if l > h {
+        let tail = dot_orders::<FMA>(&data[K * h..K * h + l - h], &t[h..]);
+        s[0] += tail;
+        for (x, r) in s[1..].iter_mut().zip(&data[K * h + l - h..]) {
+            *x += r * tail;
+        }
+    }
+    s
 }
 
 /// Runs `f` on a zeroed buffer for a series of `len` orders (at most
@@ -1540,15 +1557,9 @@ fn fourier_sum_pole<const K: usize>(
             if w == 0.0 || l < 2 {
                 continue;
             }
-            for (x, channel) in acc.iter_mut().zip(data.chunks_exact(h)) {
-                *x += w * dot_orders::<false>(&channel[1..], &a_m[1..longest]);
-            }
-            if l > h {
-                let tail = dot_orders::<false>(&data[K * h..K * h + l - h], &a_m[h..longest]);
-                acc[0] += w * tail;
-                for (x, r) in acc[1..].iter_mut().zip(&data[K * h + l - h..]) {
-                    *x += w * r * tail;
-                }
+            let s = pair_series::<K, false>(data, l, h, &a_m[..longest], 1);
+            for (x, v) in acc.iter_mut().zip(s) {
+                *x += w * v;
             }
         }
         acc
