@@ -1,5 +1,6 @@
 //! Calls `SlabBsdf::sample` (or `eval`, `pdf`) many times for a preset at
-//! directions off the nodes, for instruction counts that do not depend on
+//! directions off the nodes (or `eval_grazing`: `eval` at the benchmark's
+//! grazing pair), for instruction counts that do not depend on
 //! the machine's load (the criterion benchmark `benches/slab.rs` gives
 //! seconds):
 //!
@@ -43,8 +44,15 @@ fn main() -> Result<(), String> {
                 }
             }
             "eval" => acc += b.eval(dir(k, 0.3), wo).mean(),
+            // benches/slab.rs `eval_grazing`: near the mirror direction at
+            // 78 and 81 degrees, where the node pairs keep the most orders.
+            "eval_grazing" => {
+                let wo = DVec3::new(0.985, 0.05, 0.16).normalize();
+                let wi = DVec3::new(-0.975, 0.1, 0.21).normalize();
+                acc += b.eval(std::hint::black_box(wi), wo).mean();
+            }
             "pdf" => acc += b.pdf(dir(k, 0.3), wo),
-            _ => return Err(format!("unknown call '{what}' (sample, eval or pdf)")),
+            _ => return Err(format!("unknown call '{what}' (sample, eval, eval_grazing or pdf)")),
         }
     }
     println!("{name} {what} x {calls}: checksum {acc:.6e}");

@@ -143,8 +143,8 @@
 use crate::error::SlabError;
 use crate::interface::walk_window;
 use crate::slab::{Discretisation, SlabSpec, Solution};
-use multiversion::multiversion;
-use multiversion::target::target_cfg_f;
+#[cfg(not(feature = "sse2-only"))]
+use multiversion::{multiversion, target::target_cfg_f};
 use nalgebra::DMatrix;
 use paperbsdf_core::bsdf::{Bsdf, BsdfFlags, BsdfSample};
 use paperbsdf_core::fresnel::{cos_transmitted, fresnel_dielectric};
@@ -1397,10 +1397,20 @@ fn dot_orders<const FMA: bool>(row: &[f64], t: &[f64]) -> f64 {
 /// (`multiversion`): grazing node pairs keep up to
 /// [`SlabOptions::walk_orders`] orders, and SSE2's two lanes with a
 /// separate multiply and add were the bound there.
+/// With the crate's feature `sse2-only`, the one compiled for the target's
+/// base features (to measure what the choice gains: `cargo bench -p
+/// paperbsdf-slab --bench slab --features sse2-only`).
+#[cfg(not(feature = "sse2-only"))]
 #[multiversion(targets("x86_64+avx2+fma"))]
 fn fourier_sum<const K: usize>(tab: &Tables, st: usize, pairs: [usize; 3], weights: [f64; 3], c: f64) -> [f64; K] {
     const FMA: bool = target_cfg_f!(target_feature = "fma");
     fourier_sum_with::<K, FMA>(tab, st, pairs, weights, c)
+}
+
+/// [`fourier_sum`] without the run-time choice (feature `sse2-only`).
+#[cfg(feature = "sse2-only")]
+fn fourier_sum<const K: usize>(tab: &Tables, st: usize, pairs: [usize; 3], weights: [f64; 3], c: f64) -> [f64; K] {
+    fourier_sum_with::<K, false>(tab, st, pairs, weights, c)
 }
 
 /// [`fourier_sum`]'s body, its multiply-adds fused when `FMA` (callable

@@ -86,7 +86,7 @@
 //! slowest; the dense solves' triangular substitutions are blocked,
 //! `linalg`, which made up for the edges' 35 ms per face). `eval` at grazing
 //! angles near the mirror direction, where node pairs keep up to 256
-//! orders (the walk's forward peak), takes 183-305 ns with AVX2 and FMA
+//! orders (the walk's forward peak), takes 183-309 ns with AVX2 and FMA
 //! (benches/slab.rs `eval_grazing`; the Fourier sum is compiled for them
 //! and chosen at run time, [`bsdf`]; 280-720 ns before, 1.0-1.95 us before
 //! the sum's shared cosines), above the 200 ns but for thin
