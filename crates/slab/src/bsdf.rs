@@ -1462,8 +1462,8 @@ fn fourier_sum_with<const K: usize, const FMA: bool>(
     // A buffer no longer than needed (clearing it costs in proportion to
     // its length), as `with_series_buffer` but without a closure: a closure
     // defined here would not be compiled with `fourier_sum`'s target
-    // features (the fused path would call `mul_add` in software, 1.9 us
-    // per luster `eval` at grazing pairs).
+    // features (the fused path would call `mul_add` in software, a library
+    // call per order: several times slower, in a timing probe).
     match longest {
         l if l <= 64 => series_sum::<K, FMA>(rows, c, &mut [0.0; 64][..l]),
         l if l <= 128 => series_sum::<K, FMA>(rows, c, &mut [0.0; 128][..l]),
