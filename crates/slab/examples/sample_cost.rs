@@ -8,10 +8,13 @@
 //!
 //! (build it first with `cargo build --release -p paperbsdf-slab --example sample_cost`;
 //! the build of the sheet is counted too: subtract a run with 0 calls).
+//! An optional fourth argument sets `SlabOptions::walk_orders` (e.g. 48,
+//! the solution's orders: what `eval` costs without the walk's tail).
+//! Arguments: `[preset] [sample|eval|eval_grazing|pdf] [calls] [walk_orders]`.
 
 use paperbsdf_core::presets::preset;
 use paperbsdf_core::{Bsdf, DVec3};
-use paperbsdf_slab::SlabBsdf;
+use paperbsdf_slab::{SlabBsdf, SlabOptions};
 
 fn main() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -22,7 +25,11 @@ fn main() -> Result<(), String> {
         None => 200_000,
     };
     let p = preset(name).ok_or_else(|| format!("no preset '{name}'"))?;
-    let b = SlabBsdf::new(&p).map_err(|e| e.to_string())?;
+    let mut opts = SlabOptions::default();
+    if let Some(s) = args.get(3) {
+        opts.walk_orders = s.parse().map_err(|e| format!("walk_orders: {e} ('{s}')"))?;
+    }
+    let b = SlabBsdf::with_options(&p, &opts).map_err(|e| e.to_string())?;
     // Directions off the nodes, both sides, from a fixed low-discrepancy sequence.
     let dir = |k: usize, a: f64| {
         let u = (0.5 + k as f64 * 0.618_033_988_749_894_9).fract();

@@ -298,6 +298,13 @@ struct Tables {
     /// factors: [`shared_tail`]) are stored once with the channels' ratios,
     /// so that a three-channel sheet sums them once.
     head: [[Vec<u16>; 2]; 2],
+    /// Per pair with a tail (`len > head`): where its azimuth samples start
+    /// in `tail_phi` ([`TailSamples`]); `u32::MAX` for the others.
+    tail_at: [[Vec<u32>; 2]; 2],
+    /// The tails summed in azimuth ([`TailSamples`]): per pair with a tail,
+    /// `sum_{m = h}^{len - 1} c_m cos(m phi_k)` of channel 0 at
+    /// `phi_k = k pi / N`, `k = -1..=N + 1`, `N = TAIL_SAMPLES_PER_ORDER len`.
+    tail_phi: [[Vec<f32>; 2]; 2],
     /// Channels stored: 1 for a grey sheet (every colour channel has the
     /// same medium, so one solve and equal tables: `eval` sums one series
     /// instead of three), else 3.
@@ -328,12 +335,39 @@ impl Tables {
         (&self.c[s][t][from..from + size], l, h)
     }
 
+    /// The azimuth samples of the tail of pair `p` (keeping `l` orders) in
+    /// table `st` ([`TailSamples`]); `None` for a pair without a tail or a
+    /// table without samples (whose tails are summed as series).
+    #[inline(always)]
+    fn tail<'a>(&'a self, st: usize, p: usize, l: usize) -> Option<TailSamples<'a>> {
+        let (s, t) = (st >> 1, st & 1);
+        let from = *self.tail_at[s][t].get(p)?;
+        if from == u32::MAX {
+            return None;
+        }
+        let n = TAIL_SAMPLES_PER_ORDER * l;
+        Some(TailSamples {
+            v: &self.tail_phi[s][t][from as usize..from as usize + n + 3],
+            n,
+        })
+    }
+
     /// Truncates the orders of every node pair (`n` nodes; `orders[side][transmit]`
     /// orders per pair in `c`), packs each pair's kept orders ([`Tables::start`])
     /// and stores channel 0 alone when `grey` (all channels equal); the
     /// orders from `shared_from` (the solution's count) on once, with the
-    /// channels' ratios, where they are proportional ([`shared_tail`]).
-    fn truncate(c: [[Vec<Rgb>; 2]; 2], n: usize, orders: [[usize; 2]; 2], grey: bool, shared_from: usize) -> Tables {
+    /// channels' ratios, where they are proportional ([`shared_tail`]), and
+    /// if `samples`, those tails summed in azimuth ([`TailSamples`]; `eval`'s
+    /// table has them, the unscattered part, read only by `eval_component`,
+    /// sums its tails as series).
+    fn truncate(
+        c: [[Vec<Rgb>; 2]; 2],
+        n: usize,
+        orders: [[usize; 2]; 2],
+        grey: bool,
+        shared_from: usize,
+        samples: bool,
+    ) -> Tables {
         let mut c = c;
         let mut len: [[Vec<u16>; 2]; 2] = Default::default();
         for tab in c.iter_mut().flatten() {
@@ -391,9 +425,13 @@ impl Tables {
                     start[s][t].push(packed.len() as u32);
                     // A shared tail only past the short series (summed per
                     // pair by its own recurrence, `fourier_sum`).
-                    let ratios = (channels == 3 && coef.len() > shared_from.max(SHORT_SERIES))
-                        .then(|| shared_tail(&coef[shared_from..]))
-                        .flatten();
+                    // A grey sheet's orders past the solution's are its tail.
+                    let long = coef.len() > shared_from.max(SHORT_SERIES);
+                    let ratios = match channels {
+                        3 if long => shared_tail(&coef[shared_from..]),
+                        1 if long => Some([0.0; 2]),
+                        _ => None,
+                    };
                     let h = if ratios.is_some() { shared_from } else { coef.len() };
                     head[s][t].push(h as u16);
                     for k in 0..channels {
@@ -401,10 +439,38 @@ impl Tables {
                     }
                     if let Some(r) = ratios {
                         packed.extend(coef[h..].iter().map(|v| v.0[0]));
-                        packed.extend(r);
+                        packed.extend(&r[..channels - 1]);
                     }
                 }
                 packed
+            })
+        });
+        // The tails' azimuth samples, a pair at a time in parallel.
+        let mut tail_at: [[Vec<u32>; 2]; 2] = Default::default();
+        let tail_phi = std::array::from_fn(|s| {
+            std::array::from_fn(|t| {
+                let (len, head, start, packed) = (&sym[s][t], &head[s][t], &start[s][t], &c[s][t]);
+                let pieces: Vec<Option<Vec<f32>>> = (0..n * n)
+                    .into_par_iter()
+                    .map(|p| {
+                        let (l, h) = (len[p] as usize, head[p] as usize);
+                        (samples && l > h).then(|| {
+                            let from = start[p] as usize + channels * h;
+                            TailSamples::sum(&packed[from..from + l - h], h)
+                        })
+                    })
+                    .collect();
+                let mut all = Vec::new();
+                for piece in pieces {
+                    match piece {
+                        Some(v) => {
+                            tail_at[s][t].push(all.len() as u32);
+                            all.extend(v);
+                        }
+                        None => tail_at[s][t].push(u32::MAX),
+                    }
+                }
+                all
             })
         });
         Tables {
@@ -412,8 +478,75 @@ impl Tables {
             len: sym,
             start,
             head,
+            tail_at,
+            tail_phi,
             channels,
         }
+    }
+}
+
+/// Azimuth samples of a node pair's tail per order it keeps
+/// ([`TailSamples`]): 8, so that the cubic's error on the highest order, a
+/// phase step of `pi / 8` a sample, is `9 / 384 (pi / 8)^4 = 5.6e-4` of
+/// that order's coefficient, and 3.4e-5 at half the orders (the window
+/// leaves the walk's highest orders far smaller than its lowest).
+const TAIL_SAMPLES_PER_ORDER: usize = 8;
+
+/// A node pair's tail, the orders `h..len` past the solution's (the lit
+/// face's walk at grazing pairs: up to [`SlabOptions::walk_orders`]),
+/// summed at `N + 3` azimuths `phi_k = k pi / N`, `k = -1..=N + 1` (`N =`
+/// [`TAIL_SAMPLES_PER_ORDER`]` len`; the first and last beyond `[0, pi]`,
+/// where the even, `2 pi`-periodic sum mirrors), and interpolated by the
+/// cubic through the four samples around `phi`. `eval` reads four numbers
+/// a pair instead of summing up to `walk_orders - orders` (208) orders
+/// against as many cosines: that sum was about 45% of `eval` at grazing
+/// pairs (matte 249 against 136 ns with the walk's orders set to the
+/// solution's, `examples/sample_cost.rs`, 2026-12-05).
+#[derive(Clone, Copy, Debug)]
+struct TailSamples<'a> {
+    /// `N + 3` samples from `phi = -pi / N`, in single precision (half the
+    /// memory; rounding 6e-8 of the tail's size, against the cubic's 3e-5).
+    v: &'a [f32],
+    /// Intervals in `[0, pi]`.
+    n: usize,
+}
+
+impl TailSamples<'_> {
+    /// The samples of `sum_m a[m] cos((first + m) phi)` (layout of
+    /// [`TailSamples`], `N =` [`TAIL_SAMPLES_PER_ORDER`]` (first + a.len())`):
+    /// the Chebyshev recurrence over the orders, at all azimuths at once.
+    fn sum(a: &[f64], first: usize) -> Vec<f32> {
+        let n = TAIL_SAMPLES_PER_ORDER * (first + a.len());
+        let phi: Vec<f64> = (0..n + 3).map(|k| PI * (k as f64 - 1.0) / n as f64).collect();
+        let two_c: Vec<f64> = phi.iter().map(|p| 2.0 * p.cos()).collect();
+        let mut prev: Vec<f64> = phi.iter().map(|p| (first as f64 - 1.0) * p).map(f64::cos).collect();
+        let mut cur: Vec<f64> = phi.iter().map(|p| (first as f64 * p).cos()).collect();
+        let mut out = vec![0.0; n + 3];
+        for &x in a {
+            for k in 0..n + 3 {
+                out[k] += x * cur[k];
+                let next = two_c[k] * cur[k] - prev[k];
+                prev[k] = cur[k];
+                cur[k] = next;
+            }
+        }
+        out.into_iter().map(|x| x as f32).collect()
+    }
+
+    /// The cubic through the four samples around `phi` in `[0, pi]`.
+    #[inline(always)]
+    fn at(&self, phi: f64) -> f64 {
+        let u = phi * (self.n as f64 / PI);
+        let k = (u as usize).min(self.n - 1);
+        let t = u - k as f64;
+        let v: [f32; 4] = self.v[k..k + 4].try_into().expect("four samples");
+        let (a, b, c) = (t + 1.0, t - 1.0, t - 2.0);
+        let ab = a * t;
+        let bc = b * c;
+        // Lagrange's weights on the samples at -1, 0, 1, 2 (times 6).
+        let w = [-t * bc, 3.0 * a * bc, -3.0 * ab * c, ab * b];
+        let v = v.map(f64::from);
+        (w[0] * v[0] + w[1] * v[1] + w[2] * v[2] + w[3] * v[3]) * (1.0 / 6.0)
     }
 }
 
@@ -1392,11 +1525,13 @@ fn dot_orders<const FMA: bool>(row: &[f64], t: &[f64]) -> f64 {
 /// The Fourier series `sum_m s_m cos(m phi)` (`c = cos phi`) of the three
 /// node pairs `pairs` of a table `tab` with `K` channels, weighted by
 /// `weights`: each pair over the orders it keeps, against `cos(m phi)`
-/// computed once for the longest ([`cos_series`], [`dot_orders`]). Compiled
-/// also for AVX2 with FMA and chosen at run time where the CPU has them
-/// (`multiversion`): grazing node pairs keep up to
-/// [`SlabOptions::walk_orders`] orders, and SSE2's two lanes with a
-/// separate multiply and add were the bound there.
+/// computed once for the longest ([`cos_series`], [`dot_orders`]), a tail
+/// past the solution's orders from its azimuth samples ([`TailSamples`]).
+/// Compiled also for AVX2 with FMA and chosen at run time where the CPU
+/// has them (`multiversion`): grazing node pairs kept up to
+/// [`SlabOptions::walk_orders`] orders in the sum before the tails were
+/// sampled, and SSE2's two lanes with a separate multiply and add were the
+/// bound there.
 /// With the crate's feature `sse2-only`, the one compiled for the target's
 /// base features (to measure what the choice gains: `cargo bench -p
 /// paperbsdf-slab --bench slab --features sse2-only`).
@@ -1423,15 +1558,15 @@ fn fourier_sum_with<const K: usize, const FMA: bool>(
     weights: [f64; 3],
     c: f64,
 ) -> [f64; K] {
-    // The pairs that take part: (weight, the pair's values, orders kept,
-    // orders per channel).
-    let mut rows: [(f64, &[f64], usize, usize); 3] = [(0.0, &[], 0, 0); 3];
+    // The pairs that take part, and the most orders one sums against cosines.
+    let mut rows: [Row; 3] = [Row::default(); 3];
     let (mut count, mut longest) = (0, 0);
     for (&p, &w) in pairs.iter().zip(&weights) {
         if w != 0.0 {
             let (data, l, h) = tab.pair::<K>(st, p);
-            rows[count] = (w, data, l, h);
-            longest = longest.max(l);
+            let tail = if l > h { tab.tail(st, p, l) } else { None };
+            rows[count] = Row { w, data, l, h, tail };
+            longest = longest.max(if tail.is_some() { h } else { l });
             count += 1;
         }
     }
@@ -1440,7 +1575,7 @@ fn fourier_sum_with<const K: usize, const FMA: bool>(
     if longest <= SHORT_SERIES {
         // Most pairs keep a few orders: one recurrence per pair is cheapest
         // there (no buffer to fill).
-        for &(w, row, l, h) in rows {
+        for &Row { w, data: row, l, h, .. } in rows {
             // No shared tail this short (`Tables::truncate`).
             debug_assert_eq!(l, h);
             let mut s = [0.0f64; K];
@@ -1472,19 +1607,47 @@ fn fourier_sum_with<const K: usize, const FMA: bool>(
     }
 }
 
-/// [`fourier_sum_with`]'s long series: `rows` (weight, the pair's values,
-/// orders kept, orders per channel; [`Tables::pair`]) against `cos(m phi)`
-/// (`c = cos phi`) computed into `cos_m` (as long as the longest row).
+/// A node pair in [`fourier_sum_with`]: its weight, its values, orders kept
+/// and orders per channel ([`Tables::pair`]), and its tail's azimuth samples
+/// if it has one ([`TailSamples`]).
+#[derive(Clone, Copy, Default)]
+struct Row<'a> {
+    w: f64,
+    data: &'a [f64],
+    l: usize,
+    h: usize,
+    tail: Option<TailSamples<'a>>,
+}
+
+/// [`fourier_sum_with`]'s long series: each of `rows` over its orders per
+/// channel against `cos(m phi)` (`c = cos phi`) computed into `cos_m` (as
+/// long as the most of them), plus its tail from its azimuth samples (or
+/// as a series, in a table without them), channel 0's times the channels'
+/// ratios ([`Tables::pair`]).
 #[inline(always)]
-fn series_sum<const K: usize, const FMA: bool>(
-    rows: &[(f64, &[f64], usize, usize)],
-    c: f64,
-    cos_m: &mut [f64],
-) -> [f64; K] {
+fn series_sum<const K: usize, const FMA: bool>(rows: &[Row], c: f64, cos_m: &mut [f64]) -> [f64; K] {
     cos_series(cos_m, c, 1.0);
+    let phi = if rows.iter().any(|r| r.tail.is_some()) {
+        c.acos()
+    } else {
+        0.0
+    };
     let mut acc = [0.0f64; K];
-    for &(w, data, l, h) in rows {
-        let s = pair_series::<K, FMA>(data, l, h, cos_m, 0);
+    for &Row { w, data, l, h, tail } in rows {
+        let mut s = [0.0f64; K];
+        for (x, channel) in s.iter_mut().zip(data.chunks_exact(h)) {
+            *x = dot_orders::<FMA>(channel, &cos_m[..h]);
+        }
+        if l > h {
+            let v = match tail {
+                Some(tail) => tail.at(phi),
+                None => dot_orders::<FMA>(&data[K * h..K * h + l - h], &cos_m[h..l]),
+            };
+            s[0] += v;
+            for (x, r) in s[1..].iter_mut().zip(&data[K * h + l - h..]) {
+                *x += r * v;
+            }
+        }
         for (a, x) in acc.iter_mut().zip(s) {
             *a += w * x;
         }
@@ -2002,8 +2165,8 @@ impl SlabBsdf {
         let q: Vec<f64> = (0..n).map(|o| 2.0 * PI * g.w[o] * g.mu[o]).collect();
         fejer_where_ringing(&mut table, &mut direct, &q, orders, m_solved, if grey { 1 } else { 3 });
         let (table, direct) = (
-            Tables::truncate(table, n, orders, grey, m_solved),
-            Tables::truncate(direct, n, orders, grey, m_solved),
+            Tables::truncate(table, n, orders, grey, m_solved, true),
+            Tables::truncate(direct, n, orders, grey, m_solved, false),
         );
         let smooth = both_smooth.then(|| SmoothSheet {
             eta_f: specs[0].front.eta(),
@@ -2210,6 +2373,8 @@ impl SlabBsdf {
                     + t.len.iter().flatten().map(|v| v.len() * 2).sum::<usize>()
                     + t.start.iter().flatten().map(|v| v.len() * 4).sum::<usize>()
                     + t.head.iter().flatten().map(|v| v.len() * 2).sum::<usize>()
+                    + t.tail_at.iter().flatten().map(|v| v.len() * 4).sum::<usize>()
+                    + t.tail_phi.iter().flatten().map(|v| v.len() * 4).sum::<usize>()
             })
             .sum();
         let cells: usize = self
@@ -2510,7 +2675,8 @@ impl ComponentModel for SlabBsdf {
 mod tests {
     use super::{
         cos_series, dot_orders, fourier_sum, fourier_sum_pole, fourier_sum_with, locate, ridge_ratios, shape_at,
-        triangle_weights, CellDensity, PoleCorners, Tables, MAX_ORDERS, SHAPE_STEPS,
+        triangle_weights, CellDensity, PoleCorners, Tables, TailSamples, MAX_ORDERS, SHAPE_STEPS,
+        TAIL_SAMPLES_PER_ORDER,
     };
     use paperbsdf_core::Rgb;
     use std::f64::consts::PI;
@@ -2620,6 +2786,140 @@ mod tests {
         }
     }
 
+    /// The interpolation's error bound of a table's tail at pair `p`
+    /// ([`TailSamples`]): `sum_m |c_m| 9 / 384 (m pi / N)^4` over its
+    /// orders `h..len` (the four-point Lagrange cubic's error on `cos(m
+    /// phi)`, `theta^4 / 24` times `max |t (t^2 - 1) (t - 2)| = 9 / 16`, `theta`
+    /// the phase step `m pi / N`), plus the samples' rounding (`ROUNDING`);
+    /// 0 for a pair without a tail.
+    fn tail_bound(tab: &Tables, st: usize, p: usize, k: usize) -> f64 {
+        let (data, l, h) = match tab.channels {
+            1 => tab.pair::<1>(st, p),
+            _ => tab.pair::<3>(st, p),
+        };
+        if l <= h {
+            return 0.0;
+        }
+        let kk = tab.channels;
+        let ratio = if k == 0 {
+            1.0
+        } else {
+            data[kk * h + l - h + k - 1].abs()
+        };
+        let n = (TAIL_SAMPLES_PER_ORDER * l) as f64;
+        ratio
+            * data[kk * h..kk * h + l - h]
+                .iter()
+                .zip(h..)
+                .map(|(a, m)| a.abs() * (9.0 / 384.0 * (m as f64 * PI / n).powi(4) + ROUNDING))
+                .sum::<f64>()
+    }
+
+    /// The samples' rounding to single precision in the cubic, relative to
+    /// `sum_m |c_m|` (no sample exceeds it): half an ulp, `2^-24`, times
+    /// the sum of the cubic's weights' magnitudes, at most `1.25`.
+    const ROUNDING: f64 = 1.25 * 5.97e-8;
+
+    /// A tail's azimuth samples interpolate its series within the cubic's
+    /// error bound (`tail_bound`) at every azimuth, on and between the
+    /// samples and at the ends of `[0, pi]`, for series whose highest
+    /// orders are as large as the lowest (the hardest case: the walk's
+    /// window makes them smaller), and at the samples to their rounding.
+    #[test]
+    fn tail_samples_are_the_series() {
+        for (first, len) in [(48usize, 256usize), (48, 49), (24, 96), (48, 512)] {
+            let a: Vec<f64> = (first..len).map(|m| ((m * 7919) % 101) as f64 / 101.0 - 0.4).collect();
+            let v = TailSamples::sum(&a, first);
+            let tail = TailSamples {
+                v: &v,
+                n: TAIL_SAMPLES_PER_ORDER * len,
+            };
+            let series = |phi: f64| -> f64 { a.iter().zip(first..).map(|(x, m)| x * (m as f64 * phi).cos()).sum() };
+            let bound: f64 = a
+                .iter()
+                .zip(first..)
+                .map(|(x, m)| x.abs() * (9.0 / 384.0 * (m as f64 * PI / tail.n as f64).powi(4) + ROUNDING))
+                .sum();
+            let scale: f64 = a.iter().map(|x| x.abs()).sum();
+            let mut worst = 0.0f64;
+            for i in 0..=4000 {
+                let phi = PI * i as f64 / 4000.0;
+                let err = (tail.at(phi) - series(phi)).abs();
+                worst = worst.max(err);
+                assert!(err <= bound, "{first}..{len} phi {phi}: {err:.3e} > {bound:.3e}");
+            }
+            for k in [0, 1, tail.n / 3, tail.n - 1, tail.n] {
+                let phi = PI * k as f64 / tail.n as f64;
+                assert!(
+                    (tail.at(phi) - series(phi)).abs() <= ROUNDING * scale,
+                    "{first}..{len} sample {k}"
+                );
+            }
+            // The bound is that of the worst case, not loose by orders of magnitude.
+            assert!(worst > 0.01 * bound, "{first}..{len}: {worst:.2e} against {bound:.2e}");
+            eprintln!("tail {first}..{len}: largest error {worst:.2e}, bound {bound:.2e}, sum |c_m| {scale:.1}");
+        }
+    }
+
+    /// On the presets (whose lit face's walk keeps 256 orders at grazing
+    /// pairs), every tail's samples give its series within 1e-4 of the
+    /// largest value of its pair's whole series in azimuth (the cubic's
+    /// error on the walk's windowed orders; the convergence target
+    /// is 2e-3).
+    #[test]
+    fn preset_tails_are_their_series() {
+        for name in ["matte", "luster"] {
+            let b = super::SlabBsdf::new(&paperbsdf_core::presets::preset(name).expect("preset")).expect("build");
+            let mut tails = 0;
+            let mut worst = 0.0f64;
+            // The unscattered part's tails are summed as series (`Tables::truncate`).
+            assert!(b.direct.tail_phi.iter().flatten().all(Vec::is_empty));
+            for tab in [&b.table] {
+                let n = b.mu.len();
+                for st in 0..4 {
+                    for p in 0..n * n {
+                        let kk = tab.channels;
+                        let (data, l, h) = if kk == 1 {
+                            tab.pair::<1>(st, p)
+                        } else {
+                            tab.pair::<3>(st, p)
+                        };
+                        if l <= h {
+                            continue;
+                        }
+                        tails += 1;
+                        let tail = tab.tail(st, p, l).expect("samples");
+                        let phis: Vec<f64> = (0..=720).map(|i| PI * i as f64 / 720.0).collect();
+                        let whole = |phi: f64| -> f64 {
+                            let head: f64 = data[..h].iter().zip(0..).map(|(x, m)| x * (m as f64 * phi).cos()).sum();
+                            head + data[kk * h..kk * h + l - h]
+                                .iter()
+                                .zip(h..)
+                                .map(|(x, m)| x * (m as f64 * phi).cos())
+                                .sum::<f64>()
+                        };
+                        let big = phis.iter().map(|&f| whole(f).abs()).fold(0.0, f64::max);
+                        for &phi in &phis {
+                            let exact: f64 = data[kk * h..kk * h + l - h]
+                                .iter()
+                                .zip(h..)
+                                .map(|(x, m)| x * (m as f64 * phi).cos())
+                                .sum();
+                            let e = (tail.at(phi) - exact).abs() / big;
+                            worst = worst.max(e);
+                            assert!(
+                                e <= 1e-4,
+                                "{name} st {st} pair {p} phi {phi}: {e:.2e} of the pair's largest"
+                            );
+                        }
+                    }
+                }
+            }
+            assert!(tails > 0, "{name}: no pair keeps a tail");
+            eprintln!("{name}: {tails} tails, largest error {worst:.2e} of their pair's largest value");
+        }
+    }
+
     /// Three-channel tables whose orders from the solution's on are stored
     /// once with the channels' ratios (`Tables::truncate`, `shared_tail`)
     /// sum to what the same tables stored per channel sum to, in
@@ -2628,6 +2928,9 @@ mod tests {
     /// multiply-adds (both paths of the run-time choice; also for one
     /// channel); a tail that is not proportional
     /// (one coefficient off by 1e-9 of the largest) is stored per channel.
+    /// `fourier_sum` takes a tail from its azimuth samples ([`TailSamples`]):
+    /// there the two agree within the cubic's error bound (`tail_bound`),
+    /// the pole's series (which sums the tail's orders) to rounding.
     #[test]
     fn shared_tails_sum_as_the_channels() {
         let (n, orders, from) = (4usize, 96usize, 24usize);
@@ -2649,9 +2952,12 @@ mod tests {
         // under transposition), 12 elsewhere; transmission 12 everywhere
         // (below the shared start: no tail).
         let c = [0, 1].map(|_| [make(|p| p % 3 == 0), make(|_| false)]);
-        let shared = Tables::truncate(c.clone(), n, [[orders; 2]; 2], false, from);
-        let plain = Tables::truncate(c.clone(), n, [[orders; 2]; 2], false, usize::MAX / 2);
-        let plain_grey = Tables::truncate(c.clone(), n, [[orders; 2]; 2], true, from);
+        let shared = Tables::truncate(c.clone(), n, [[orders; 2]; 2], false, from, true);
+        let plain = Tables::truncate(c.clone(), n, [[orders; 2]; 2], false, usize::MAX / 2, true);
+        let plain_grey = Tables::truncate(c.clone(), n, [[orders; 2]; 2], true, from, true);
+        // The same tails summed as series.
+        let series = Tables::truncate(c.clone(), n, [[orders; 2]; 2], false, from, false);
+        let series_grey = Tables::truncate(c.clone(), n, [[orders; 2]; 2], true, from, false);
         assert!(
             shared.head[0][0].iter().any(|&h| h as usize == from),
             "no pair shares its tail"
@@ -2661,6 +2967,13 @@ mod tests {
             for pairs in [[0, 1, 5], [3, 6, 9], [15, 12, 0], [7, 10, 13]] {
                 for cphi in [1.0, 0.9, 0.1, -0.5, -1.0] {
                     let weights = [0.2, 0.5, 0.3];
+                    let bound = |tab: &Tables, k: usize| -> f64 {
+                        pairs
+                            .iter()
+                            .zip(&weights)
+                            .map(|(&p, w)| w * tail_bound(tab, st, p, k))
+                            .sum()
+                    };
                     let (a, b) = (
                         fourier_sum::<3>(&shared, st, pairs, weights, cphi),
                         fourier_sum::<3>(&plain, st, pairs, weights, cphi),
@@ -2671,15 +2984,27 @@ mod tests {
                         fourier_sum_with::<3, false>(&shared, st, pairs, weights, cphi),
                     ] {
                         for k in 0..3 {
-                            assert!((fused[k] - b[k]).abs() <= 1e-12 * b[k].abs().max(1.0));
+                            let tol = bound(&shared, k) + 1e-12 * b[k].abs().max(1.0);
+                            assert!((fused[k] - b[k]).abs() <= tol);
                         }
                     }
+                    // Tails summed as series: the per-channel sums to rounding.
+                    for (k, x) in fourier_sum::<3>(&series, st, pairs, weights, cphi).iter().enumerate() {
+                        assert!(
+                            (x - b[k]).abs() <= 1e-12 * b[k].abs().max(1.0),
+                            "series {x} vs {}",
+                            b[k]
+                        );
+                    }
+                    let exact_grey = fourier_sum::<1>(&series_grey, st, pairs, weights, cphi)[0];
                     let want = fourier_sum::<1>(&plain_grey, st, pairs, weights, cphi)[0];
                     for g in [
                         fourier_sum_with::<1, true>(&plain_grey, st, pairs, weights, cphi)[0],
                         fourier_sum_with::<1, false>(&plain_grey, st, pairs, weights, cphi)[0],
                     ] {
                         assert!((g - want).abs() <= 1e-12 * want.abs().max(1.0), "grey {g} vs {want}");
+                        let tol = bound(&plain_grey, 0) + 1e-12 * exact_grey.abs().max(1.0);
+                        assert!((g - exact_grey).abs() <= tol, "grey {g} vs the series {exact_grey}");
                     }
                     let pole = PoleCorners {
                         pairs: [pairs[0], pairs[1]],
@@ -2692,7 +3017,7 @@ mod tests {
                     );
                     for k in 0..3 {
                         assert!(
-                            (a[k] - b[k]).abs() <= 1e-12 * b[k].abs().max(1.0),
+                            (a[k] - b[k]).abs() <= bound(&shared, k) + 1e-12 * b[k].abs().max(1.0),
                             "st {st} {pairs:?} c {cphi} k {k}: {} vs {}",
                             a[k],
                             b[k]
@@ -2711,7 +3036,7 @@ mod tests {
         let mut off = c;
         let big = off[0][0][..orders].iter().map(|v| v.0[0]).fold(0.0, f64::max);
         off[0][0][from + 5].0[2] += 1e-9 * big;
-        let t = Tables::truncate(off, n, [[orders; 2]; 2], false, from);
+        let t = Tables::truncate(off, n, [[orders; 2]; 2], false, from, true);
         assert_eq!(t.head[0][0][0], t.len[0][0][0], "a tail off by 1e-9 was shared");
     }
 
