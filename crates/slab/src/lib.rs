@@ -86,11 +86,14 @@
 //! slowest; the dense solves' triangular substitutions are blocked,
 //! `linalg`, which made up for the edges' 35 ms per face). `eval` at grazing
 //! angles near the mirror direction, where node pairs keep up to 256
-//! orders (the walk's forward peak), takes 183-309 ns with AVX2 and FMA
-//! (benches/slab.rs `eval_grazing`; the Fourier sum is compiled for them
-//! and chosen at run time, [`bsdf`]; 280-720 ns before, 1.0-1.95 us before
-//! the sum's shared cosines), above the 200 ns but for thin
-//! tissue; mid angles 49-108 ns, `sample` 255-281 ns. Near `eta_f = eta_b` from
+//! orders (the walk's forward peak), takes 125-167 ns with AVX2 and FMA
+//! (benches/slab.rs `eval_grazing`, 2026-12-05 evening: the orders past
+//! the solution's 48 are read from samples of their sum in azimuth,
+//! [`bsdf`]; 132-211 ns back to back before that, 183-309 ns in the
+//! slower machine state of the runs before, 280-720 ns before the Fourier
+//! sum's changes, 1.0-1.95 us before its shared cosines); matte, three
+//! channels, is the slowest and may pass 200 ns on a slowed machine;
+//! mid angles 49-108 ns, `sample` 255-281 ns (in that slower state). Near `eta_f = eta_b` from
 //! below (the base denser) the discretisation moves with the boundary's
 //! critical cosine, by `O(sqrt(eta_b - eta_f))` (8e-5 in the totals at a
 //! difference of 1e-6; tests/coated.rs).
