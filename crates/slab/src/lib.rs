@@ -86,10 +86,10 @@
 //! slowest; the dense solves' triangular substitutions are blocked,
 //! `linalg`, which made up for the edges' 35 ms per face). `eval` at grazing
 //! angles near the mirror direction, where node pairs keep up to 256
-//! orders (the walk's forward peak), takes 125-167 ns with AVX2 and FMA
-//! (benches/slab.rs `eval_grazing`, 2026-12-05 evening: the orders past
-//! the solution's 48 are read from samples of their sum in azimuth,
-//! [`bsdf`]; 132-211 ns back to back before that, 183-309 ns in the
+//! orders (the walk's forward peak), takes 125-152 ns with AVX2 and FMA
+//! (benches/slab.rs `eval_grazing`, 2026-12-05 evening: those pairs'
+//! series are read from samples of their sums in azimuth, [`bsdf`];
+//! 132-211 ns back to back before that, 183-309 ns in the
 //! slower machine state of the runs before, 280-720 ns before the Fourier
 //! sum's changes, 1.0-1.95 us before its shared cosines); matte, three
 //! channels, is the slowest and may pass 200 ns on a slowed machine;
