@@ -192,7 +192,7 @@ pub struct SlabOptions {
     /// gives the orders above `orders` costs 0.02-0.05 s per face (timed
     /// inside the build while writing it; examples/walk_orders.rs gives the
     /// whole build against `walk_orders`). `eval` reads the orders past
-    /// `orders` from samples of their sum in azimuth (module `bsdf`, `TailSamples`), so
+    /// `orders` from samples of their sum in azimuth (module `bsdf`, `SeriesSamples`), so
     /// its time does not grow with `walk_orders`; 512 (which resolves devB's
     /// Beckmann 0.08 front, README "Convergence") costs devB 0.17 s more
     /// build (0.76-0.81 s against 0.59-0.70 s on 2026-12-05, a probe timing
@@ -304,14 +304,14 @@ struct Tables {
     /// so that a three-channel sheet sums them once.
     head: [[Vec<u16>; 2]; 2],
     /// Per pair with a tail (`len > head`): where its azimuth samples start
-    /// in `tail_phi` ([`PairSamples`]); `u32::MAX` for the others.
-    tail_at: [[Vec<u32>; 2]; 2],
+    /// in `sample_values` ([`PairSamples`]); `u32::MAX` for the others.
+    samples_at: [[Vec<u32>; 2]; 2],
     /// The series of the pairs with a tail summed in azimuth
     /// ([`PairSamples`]): per such pair the tail, `sum_{m = h}^{len - 1}
-    /// c_m cos(m phi_k)` of channel 0 at `phi_k = k pi / N`, `k = -1..=N +
-    /// 1`, `N = TAIL_SAMPLES_PER_ORDER len`, then each channel's head, `sum_{m
-    /// < h} c_m cos(m phi_k)` with `N = TAIL_SAMPLES_PER_ORDER h`.
-    tail_phi: [[Vec<f32>; 2]; 2],
+    /// c_m cos(m phi_k)` of channel 0 at `phi_k = k pi / N`, `k = -2..=N +
+    /// 2`, `N = SAMPLES_PER_ORDER len`, then each channel's head, `sum_{m
+    /// < h} c_m cos(m phi_k)` with `N = SAMPLES_PER_ORDER h`.
+    sample_values: [[Vec<f32>; 2]; 2],
     /// Channels stored: 1 for a grey sheet (every colour channel has the
     /// same medium, so one solve and equal tables: `eval` sums one series
     /// instead of three), else 3.
@@ -348,13 +348,13 @@ impl Tables {
     #[inline(always)]
     fn samples(&self, st: usize, p: usize, l: usize, h: usize) -> Option<PairSamples<'_>> {
         let (s, t) = (st >> 1, st & 1);
-        let from = *self.tail_at[s][t].get(p)?;
+        let from = *self.samples_at[s][t].get(p)?;
         if from == u32::MAX {
             return None;
         }
         let size = PairSamples::size(l, h, self.channels);
         Some(PairSamples {
-            v: &self.tail_phi[s][t][from as usize..from as usize + size],
+            v: &self.sample_values[s][t][from as usize..from as usize + size],
             l,
             h,
         })
@@ -365,16 +365,16 @@ impl Tables {
     /// and stores channel 0 alone when `grey` (all channels equal); the
     /// orders from `shared_from` (the solution's count) on once, with the
     /// channels' ratios, where they are proportional ([`shared_tail`]), and
-    /// if `samples`, those tails summed in azimuth ([`TailSamples`]; `eval`'s
-    /// table has them, the unscattered part, read only by `eval_component`,
-    /// sums its tails as series).
+    /// if `sampled`, the series of the pairs with a tail summed in azimuth
+    /// ([`PairSamples`]; `eval`'s table has them, the unscattered part, read
+    /// only by `eval_component`, sums its tails as series).
     fn truncate(
         c: [[Vec<Rgb>; 2]; 2],
         n: usize,
         orders: [[usize; 2]; 2],
         grey: bool,
         shared_from: usize,
-        samples: bool,
+        sampled: bool,
     ) -> Tables {
         let mut c = c;
         let mut len: [[Vec<u16>; 2]; 2] = Default::default();
@@ -435,39 +435,38 @@ impl Tables {
                     // pair by its own recurrence, `fourier_sum`).
                     // A grey sheet's orders past the solution's are its tail.
                     let long = coef.len() > shared_from.max(SHORT_SERIES);
-                    let ratios = match channels {
-                        3 if long => shared_tail(&coef[shared_from..]),
-                        1 if long => Some([0.0; 2]),
-                        _ => None,
-                    };
-                    let h = if ratios.is_some() { shared_from } else { coef.len() };
+                    let ratios = (channels == 3 && long)
+                        .then(|| shared_tail(&coef[shared_from..]))
+                        .flatten();
+                    let tail = ratios.is_some() || (channels == 1 && long);
+                    let h = if tail { shared_from } else { coef.len() };
                     head[s][t].push(h as u16);
                     for k in 0..channels {
                         packed.extend(coef[..h].iter().map(|v| v.0[k]));
                     }
-                    if let Some(r) = ratios {
+                    if tail {
                         packed.extend(coef[h..].iter().map(|v| v.0[0]));
-                        packed.extend(&r[..channels - 1]);
+                        packed.extend(ratios.iter().flatten());
                     }
                 }
                 packed
             })
         });
         // The tails' azimuth samples, a pair at a time in parallel.
-        let mut tail_at: [[Vec<u32>; 2]; 2] = Default::default();
-        let tail_phi = std::array::from_fn(|s| {
+        let mut samples_at: [[Vec<u32>; 2]; 2] = Default::default();
+        let sample_values = std::array::from_fn(|s| {
             std::array::from_fn(|t| {
                 let (len, head, start, packed) = (&sym[s][t], &head[s][t], &start[s][t], &c[s][t]);
                 let pieces: Vec<Option<Vec<f32>>> = (0..n * n)
                     .into_par_iter()
                     .map(|p| {
                         let (l, h) = (len[p] as usize, head[p] as usize);
-                        (samples && l > h).then(|| {
+                        (sampled && l > h).then(|| {
                             let from = start[p] as usize;
                             let tail = from + channels * h;
-                            let mut v = TailSamples::sum(&packed[tail..tail + l - h], h);
+                            let mut v = SeriesSamples::sum(&packed[tail..tail + l - h], h);
                             for k in 0..channels {
-                                v.extend(TailSamples::sum(&packed[from + k * h..from + (k + 1) * h], 0));
+                                v.extend(SeriesSamples::sum(&packed[from + k * h..from + (k + 1) * h], 0));
                             }
                             v
                         })
@@ -477,10 +476,10 @@ impl Tables {
                 for piece in pieces {
                     match piece {
                         Some(v) => {
-                            tail_at[s][t].push(all.len() as u32);
+                            samples_at[s][t].push(all.len() as u32);
                             all.extend(v);
                         }
-                        None => tail_at[s][t].push(u32::MAX),
+                        None => samples_at[s][t].push(u32::MAX),
                     }
                 }
                 all
@@ -491,29 +490,31 @@ impl Tables {
             len: sym,
             start,
             head,
-            tail_at,
-            tail_phi,
+            samples_at,
+            sample_values,
             channels,
         }
     }
 }
 
-/// Azimuth samples per order of a series ([`TailSamples`]): 8, so that the
+/// Azimuth samples per order of a series ([`SeriesSamples`]): 8, so that the
 /// quintic's error on the highest order, a phase step of `pi / 8` a
 /// sample, is `225 / 46080 (pi / 8)^6 = 1.8e-5` of that order's
 /// coefficient, and 2.8e-7 at half the orders (the cubic's, `9 / 384 (pi /
-/// 8)^4`, was 5.6e-4: a luster value at the grazing pair moved by 9e-4
-/// with the heads sampled, 5-point probe against the series).
-const TAIL_SAMPLES_PER_ORDER: usize = 8;
+/// 8)^4`, was 5.6e-4: with it and the heads sampled a luster value at
+/// the grazing pair was 9e-4 off the series, 2.4e-5 with the quintic;
+/// `examples/sample_cost.rs luster eval_grazing 1` against a build with
+/// the table's samples turned off, a probe not kept).
+const SAMPLES_PER_ORDER: usize = 8;
 
-/// Samples of a series past `N` ([`TailSamples`]): `N + GHOSTS` in all,
+/// Samples of a series past `N` ([`SeriesSamples`]): `N + GHOSTS` in all,
 /// `N + 1` in `[0, pi]` and two beyond either end, which the quintic's six
 /// reach.
 const GHOSTS: usize = 5;
 
 /// A node pair's series summed in azimuth where it has a tail (the grazing
-/// pairs): the tail's samples ([`TailSamples`]) and each channel's head's,
-/// orders `0..h` (at `N = `[`TAIL_SAMPLES_PER_ORDER`]` h`): `eval` then sums
+/// pairs): the tail's samples ([`SeriesSamples`]) and each channel's head's,
+/// orders `0..h` (at `N = `[`SAMPLES_PER_ORDER`]` h`): `eval` then sums
 /// no series at those pairs. Against the tails alone sampled: matte at the
 /// grazing pair 161-170 -> 149-152 ns, the grey sheets within the runs'
 /// noise (criterion `eval_grazing`, two runs each back to back,
@@ -532,14 +533,14 @@ struct PairSamples<'a> {
 impl PairSamples<'_> {
     /// Samples of a pair keeping `l` orders, `h` per channel, in `channels`.
     fn size(l: usize, h: usize, channels: usize) -> usize {
-        TAIL_SAMPLES_PER_ORDER * l + GHOSTS + channels * (TAIL_SAMPLES_PER_ORDER * h + GHOSTS)
+        SAMPLES_PER_ORDER * l + GHOSTS + channels * (SAMPLES_PER_ORDER * h + GHOSTS)
     }
 
     /// The tail's samples.
     #[inline(always)]
-    fn tail(&self) -> TailSamples<'_> {
-        let n = TAIL_SAMPLES_PER_ORDER * self.l;
-        TailSamples {
+    fn tail(&self) -> SeriesSamples<'_> {
+        let n = SAMPLES_PER_ORDER * self.l;
+        SeriesSamples {
             v: &self.v[..n + GHOSTS],
             n,
         }
@@ -547,10 +548,10 @@ impl PairSamples<'_> {
 
     /// Channel `k`'s head's samples.
     #[inline(always)]
-    fn head(&self, k: usize) -> TailSamples<'_> {
-        let nt = TAIL_SAMPLES_PER_ORDER * self.l + GHOSTS;
-        let n = TAIL_SAMPLES_PER_ORDER * self.h;
-        TailSamples {
+    fn head(&self, k: usize) -> SeriesSamples<'_> {
+        let nt = SAMPLES_PER_ORDER * self.l + GHOSTS;
+        let n = SAMPLES_PER_ORDER * self.h;
+        SeriesSamples {
             v: &self.v[nt + k * (n + GHOSTS)..nt + (k + 1) * (n + GHOSTS)],
             n,
         }
@@ -569,13 +570,14 @@ impl PairSamples<'_> {
     }
 }
 
-/// A node pair's tail, the orders `h..len` past the solution's (the lit
-/// face's walk at grazing pairs: up to [`SlabOptions::walk_orders`]),
-/// summed at `N + 5` azimuths `phi_k = k pi / N`, `k = -2..=N + 2` (`N =`
-/// [`TAIL_SAMPLES_PER_ORDER`]` len`; the first and last two beyond `[0, pi]`,
-/// where the even, `2 pi`-periodic sum mirrors), and interpolated by the
-/// quintic through the six samples around `phi` (a head, orders `0..h`,
-/// the same way, [`PairSamples`]). `eval` reads six numbers
+/// A Fourier series in azimuth, `sum_{m = first}^{len - 1} a_m cos(m
+/// phi)`, summed at `N + 5` azimuths `phi_k = k pi / N`, `k = -2..=N + 2`
+/// (`N =` [`SAMPLES_PER_ORDER`]` len`; the first and last two beyond `[0,
+/// pi]`, where the even, `2 pi`-periodic sum mirrors), and interpolated by
+/// the quintic through the six samples around `phi`: a node pair's tail,
+/// the orders `h..len` past the solution's (the lit face's walk at
+/// grazing pairs: up to [`SlabOptions::walk_orders`]), or a channel's
+/// head, orders `0..h` ([`PairSamples`]). `eval` reads six numbers
 /// a pair instead of summing up to `walk_orders - orders` (208) orders
 /// against as many cosines: that sum was about 45% of `eval` at grazing
 /// pairs (matte 249 against 136 ns with the walk's orders set to the
@@ -583,11 +585,11 @@ impl PairSamples<'_> {
 /// part's table (read by `eval_component` alone) sums its tails as series,
 /// so [`Component::Multiple`], the table less that part, carries the
 /// samples' error of the pairs both hold (within 1.6e-6 of a sampled
-/// pair's largest value on the presets, `preset_tails_are_their_series`;
+/// pair's largest value on the presets, `preset_samples_are_their_series`;
 /// 2.8e-5 for the tails with a cubic through four samples, as first
 /// written).
 #[derive(Clone, Copy, Debug)]
-struct TailSamples<'a> {
+struct SeriesSamples<'a> {
     /// `N + 5` samples from `phi = -2 pi / N`, in single precision (half the
     /// memory; rounding 6e-8 of the series' size).
     v: &'a [f32],
@@ -595,12 +597,12 @@ struct TailSamples<'a> {
     n: usize,
 }
 
-impl TailSamples<'_> {
+impl SeriesSamples<'_> {
     /// The samples of `sum_m a[m] cos((first + m) phi)` (layout of
-    /// [`TailSamples`], `N =` [`TAIL_SAMPLES_PER_ORDER`]` (first + a.len())`):
+    /// [`SeriesSamples`], `N =` [`SAMPLES_PER_ORDER`]` (first + a.len())`):
     /// the Chebyshev recurrence over the orders, at all azimuths at once.
     fn sum(a: &[f64], first: usize) -> Vec<f32> {
-        let n = TAIL_SAMPLES_PER_ORDER * (first + a.len());
+        let n = SAMPLES_PER_ORDER * (first + a.len());
         let phi: Vec<f64> = (0..n + GHOSTS).map(|k| PI * (k as f64 - 2.0) / n as f64).collect();
         let two_c: Vec<f64> = phi.iter().map(|p| 2.0 * p.cos()).collect();
         let mut prev: Vec<f64> = phi.iter().map(|p| (first as f64 - 1.0) * p).map(f64::cos).collect();
@@ -648,7 +650,7 @@ impl TailSamples<'_> {
         )
     }
 
-    /// The quintic at the place [`TailSamples::weights`] gave (for samples
+    /// The quintic at the place [`SeriesSamples::weights`] gave (for samples
     /// of the same `N`).
     #[inline(always)]
     fn at_with(&self, k: usize, w: [f64; 6]) -> f64 {
@@ -1634,7 +1636,7 @@ fn dot_orders<const FMA: bool>(row: &[f64], t: &[f64]) -> f64 {
 /// node pairs `pairs` of a table `tab` with `K` channels, weighted by
 /// `weights`: each pair over the orders it keeps, against `cos(m phi)`
 /// computed once for the longest ([`cos_series`], [`dot_orders`]), a tail
-/// past the solution's orders from its azimuth samples ([`TailSamples`]).
+/// past the solution's orders from its azimuth samples ([`SeriesSamples`]).
 /// Compiled also for AVX2 with FMA and chosen at run time where the CPU
 /// has them (`multiversion`): grazing node pairs kept up to
 /// [`SlabOptions::walk_orders`] orders in the sum before the tails were
@@ -2475,8 +2477,8 @@ impl SlabBsdf {
                     + t.len.iter().flatten().map(|v| v.len() * 2).sum::<usize>()
                     + t.start.iter().flatten().map(|v| v.len() * 4).sum::<usize>()
                     + t.head.iter().flatten().map(|v| v.len() * 2).sum::<usize>()
-                    + t.tail_at.iter().flatten().map(|v| v.len() * 4).sum::<usize>()
-                    + t.tail_phi.iter().flatten().map(|v| v.len() * 4).sum::<usize>()
+                    + t.samples_at.iter().flatten().map(|v| v.len() * 4).sum::<usize>()
+                    + t.sample_values.iter().flatten().map(|v| v.len() * 4).sum::<usize>()
             })
             .sum();
         let cells: usize = self
@@ -2777,8 +2779,7 @@ impl ComponentModel for SlabBsdf {
 mod tests {
     use super::{
         cos_series, dot_orders, fourier_sum, fourier_sum_pole, fourier_sum_with, locate, ridge_ratios, shape_at,
-        triangle_weights, CellDensity, PoleCorners, Tables, TailSamples, MAX_ORDERS, SHAPE_STEPS,
-        TAIL_SAMPLES_PER_ORDER,
+        triangle_weights, CellDensity, PoleCorners, SeriesSamples, Tables, MAX_ORDERS, SAMPLES_PER_ORDER, SHAPE_STEPS,
     };
     use paperbsdf_core::Rgb;
     use std::f64::consts::PI;
@@ -2888,12 +2889,9 @@ mod tests {
         }
     }
 
-    /// The interpolation's error bound of a table's tail at pair `p`
-    /// ([`TailSamples`]): `sum_m |c_m| 9 / 384 (m pi / N)^4` over its
-    /// orders `h..len` (the four-point Lagrange cubic's error on `cos(m
-    /// phi)`, `theta^4 / 24` times `max |t (t^2 - 1) (t - 2)| = 9 / 16`, `theta`
-    /// the phase step `m pi / N`), plus the samples' rounding (`ROUNDING`);
-    /// 0 for a pair without a tail.
+    /// The interpolation's error bound of channel `k` of a table's pair `p`
+    /// ([`PairSamples`]): `series_bound` of its head plus its ratio times
+    /// that of its tail; 0 for a pair without samples.
     fn tail_bound(tab: &Tables, st: usize, p: usize, k: usize) -> f64 {
         let (data, l, h) = match tab.channels {
             1 => tab.pair::<1>(st, p),
@@ -2912,12 +2910,12 @@ mod tests {
     }
 
     /// The quintic's error bound on the samples of `sum_m a[m] cos((first +
-    /// m) phi)` ([`TailSamples`]): `225 / 46080 (m pi / N)^6 |a_m|` per order
+    /// m) phi)` ([`SeriesSamples`]): `225 / 46080 (m pi / N)^6 |a_m|` per order
     /// (the six-point Lagrange error `theta^6 / 720` times `max |(t + 2) (t +
     /// 1) t (t - 1) (t - 2) (t - 3)|` on `[0, 1]`, `3.515625` at `t = 1/2`;
     /// `theta` the phase step `m pi / N`), plus the samples' rounding.
     fn series_bound(a: &[f64], first: usize) -> f64 {
-        let n = (TAIL_SAMPLES_PER_ORDER * (first + a.len())) as f64;
+        let n = (SAMPLES_PER_ORDER * (first + a.len())) as f64;
         a.iter()
             .zip(first..)
             .map(|(x, m)| x.abs() * (225.0 / 46080.0 * (m as f64 * PI / n).powi(6) + ROUNDING))
@@ -2937,13 +2935,13 @@ mod tests {
     /// smaller), heads (from order 0) and tails, and at the samples to their
     /// rounding.
     #[test]
-    fn tail_samples_are_the_series() {
+    fn series_samples_are_the_series() {
         for (first, len) in [(48usize, 256usize), (48, 49), (24, 96), (48, 512), (0, 48), (0, 5)] {
             let a: Vec<f64> = (first..len).map(|m| ((m * 7919) % 101) as f64 / 101.0 - 0.4).collect();
-            let v = TailSamples::sum(&a, first);
-            let tail = TailSamples {
+            let v = SeriesSamples::sum(&a, first);
+            let tail = SeriesSamples {
                 v: &v,
-                n: TAIL_SAMPLES_PER_ORDER * len,
+                n: SAMPLES_PER_ORDER * len,
             };
             assert_eq!(v.len(), tail.n + super::GHOSTS);
             let series = |phi: f64| -> f64 { a.iter().zip(first..).map(|(x, m)| x * (m as f64 * phi).cos()).sum() };
@@ -2973,13 +2971,13 @@ mod tests {
     /// quintic's error on the walk's orders; the convergence target
     /// is 2e-3).
     #[test]
-    fn preset_tails_are_their_series() {
+    fn preset_samples_are_their_series() {
         for name in ["matte", "luster"] {
             let b = super::SlabBsdf::new(&paperbsdf_core::presets::preset(name).expect("preset")).expect("build");
             let mut tails = 0;
             let mut worst = 0.0f64;
             // The unscattered part's tails are summed as series (`Tables::truncate`).
-            assert!(b.direct.tail_phi.iter().flatten().all(Vec::is_empty));
+            assert!(b.direct.sample_values.iter().flatten().all(Vec::is_empty));
             for tab in [&b.table] {
                 let n = b.mu.len();
                 for st in 0..4 {
@@ -3043,9 +3041,10 @@ mod tests {
     /// multiply-adds (both paths of the run-time choice; also for one
     /// channel); a tail that is not proportional
     /// (one coefficient off by 1e-9 of the largest) is stored per channel.
-    /// `fourier_sum` takes a tail from its azimuth samples ([`TailSamples`]):
-    /// there the two agree within the cubic's error bound (`tail_bound`),
-    /// the pole's series (which sums the tail's orders) to rounding.
+    /// `fourier_sum` reads a pair with a tail from its azimuth samples
+    /// ([`PairSamples`]): there the two agree within the quintic's error
+    /// bound (`tail_bound`), the pole's series (which sums the tail's
+    /// orders) to rounding.
     #[test]
     fn shared_tails_sum_as_the_channels() {
         let (n, orders, from) = (4usize, 96usize, 24usize);
