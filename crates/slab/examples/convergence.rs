@@ -1,19 +1,23 @@
 //! Convergence of the model `slab` in its discretisation, measured where the
-//! renderer sees it: `SlabBsdf::eval` at in-plane directions (`theta_i` 0,
-//! 2.5, 30, 45, 60, 75 degrees, `theta_o = -80..80` step 5 and +-2.5: the
-//! points of docs/accuracy.md, the points between them and the last
-//! interval of nodes near the normal, 4.85 degrees wide; reflection and
-//! transmission, light on the front), and the
-//! directional albedo, for the default options against doubled nodes
-//! (64 outside, 32 in the cone of total reflection) and against doubled
-//! Fourier orders (96, and 256 for the lit face's walk), for every case of docs/accuracy.md (the presets,
-//! devA, devB and the spread of sheets), in both face modes.
+//! renderer sees it: `SlabBsdf::eval` in the plane of incidence on a dense
+//! grid (`theta_i` 0 to 80 degrees and `theta_o` -80 to 80, every half
+//! degree: the nodes of 32, 64 and 128, the points between them and the
+//! points of docs/accuracy.md; reflection and transmission, light on the
+//! front), and the directional albedo, for the default options against
+//! doubled nodes (64 outside, 32 in the cone of total reflection) and
+//! against doubled Fourier orders (96, and 512 for the lit face's walk), for
+//! every case of docs/accuracy.md (the presets, devA, devB and the spread of
+//! sheets), in both face modes. Until 2026-12-06 the points were `theta_i`
+//! 0, 2.5, 30, 45, 60, 75 only, which missed the largest changes (between
+//! 5 and 15 degrees from the normal, where no `theta_i` was).
 //!
 //! Printed per sheet: the largest relative change of a value (with the
-//! in-plane point where it happens), the RMS relative change, and the
-//! largest change of the albedo. Values below `1e-3` of the sheet's largest
-//! in-plane value are left out of the relative change (the far tails of a
-//! narrow lobe, where a relative change says nothing a renderer sees).
+//! in-plane point where it happens), the largest within 5 degrees of the
+//! normal (either direction), from 5 to 15 degrees, and further out, the RMS
+//! relative change, and the largest change of the albedo. Values below
+//! `1e-3` of the sheet's largest in-plane value are left out of the relative
+//! change (the far tails of a narrow lobe, where a relative change says
+//! nothing a renderer sees).
 //!
 //! `cargo run --release -p paperbsdf-slab --example convergence [CASE...]`
 //! (optional case names, e.g. `thin-tissue devB`: only those cases).
@@ -27,21 +31,41 @@ use paperbsdf_slab::{SlabBsdf, SlabOptions};
 #[path = "../../sim/examples/support/cases.rs"]
 mod cases;
 
+/// An in-plane point: `theta_i`, transmission, `theta_o` (degrees).
+type Point = (f64, bool, f64);
+
 /// In-plane values (mean over channels) and the points they belong to.
-fn in_plane(b: &SlabBsdf) -> (Vec<f64>, Vec<String>) {
+fn in_plane(b: &SlabBsdf) -> (Vec<f64>, Vec<Point>) {
     let mut v = Vec::new();
     let mut at = Vec::new();
-    for ti in [0.0, 2.5, 30.0, 45.0, 60.0, 75.0] {
+    for ti in (0..=160).map(|k| 0.5 * k as f64) {
         for tr in [false, true] {
-            let steps = (-16..=16).map(|k| 5.0 * k as f64).chain([-2.5, 2.5]);
-            for to in steps {
+            for to in (-160..=160).map(|k| 0.5 * k as f64) {
                 let (wi, wo) = in_plane_directions(ti, to, tr);
                 v.push(b.eval(wi, wo).mean());
-                at.push(format!("{ti} {} {to}", if tr { "T" } else { "R" }));
+                at.push((ti, tr, to));
             }
         }
     }
     (v, at)
+}
+
+/// How an in-plane point is printed.
+fn show((ti, tr, to): Point) -> String {
+    format!("{ti} {} {to}", if tr { "T" } else { "R" })
+}
+
+/// The band of a point: within 5 degrees of the normal (either direction),
+/// 5 to 15, further out.
+fn band((ti, _, to): Point) -> usize {
+    let near = ti.min(to.abs());
+    if near < 5.0 {
+        0
+    } else if near < 15.0 {
+        1
+    } else {
+        2
+    }
 }
 
 fn albedos(b: &SlabBsdf) -> Vec<f64> {
@@ -94,24 +118,31 @@ fn main() {
                 let b1 = SlabBsdf::with_options(&p, opts).expect("build");
                 let (v1, _) = in_plane(&b1);
                 let a1 = albedos(&b1);
-                let (mut worst, mut where_, mut sum, mut n) = (0.0f64, String::new(), 0.0, 0);
-                for ((x, y), w) in v0.iter().zip(&v1).zip(&at) {
+                let (mut worst, mut where_, mut sum, mut n) = (0.0f64, (0.0, false, 0.0), 0.0, 0);
+                let mut bands = [0.0f64; 3];
+                for ((x, y), &w) in v0.iter().zip(&v1).zip(&at) {
                     if x.max(*y) < floor {
                         continue;
                     }
                     let r = (y / x - 1.0).abs();
                     sum += r * r;
                     n += 1;
+                    let b = &mut bands[band(w)];
+                    *b = b.max(r);
                     if r > worst {
                         worst = r;
-                        where_ = w.clone();
+                        where_ = w;
                     }
                 }
                 let da = a0.iter().zip(&a1).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
                 println!(
-                    "{:8} {name:14} {vname:9}: largest {:.2}% at ({where_}), RMS {:.3}%, albedo {:.1e}",
+                    "{:8} {name:14} {vname:9}: largest {:.2}% at ({}); <5 deg {:.2}%, 5-15 {:.2}%, beyond {:.2}%; RMS {:.3}%, albedo {:.1e}",
                     faces.name(),
                     100.0 * worst,
+                    show(where_),
+                    100.0 * bands[0],
+                    100.0 * bands[1],
+                    100.0 * bands[2],
                     100.0 * (sum / n as f64).sqrt(),
                     da
                 );

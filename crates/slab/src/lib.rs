@@ -59,11 +59,14 @@
 //! reflection at grazing incidence on a smooth face beyond 85 degrees
 //! (summed to its own 256 orders since 2026-12-05, [`interface`]: at 75
 //! degrees within 0.001% of twice the orders, 4.6-6.2% before; at 85 R -85
-//! luster 2.2%, where the pairs beyond 85 degrees keep Fejer's weights); a thin sheet's unscattered transmission
-//! moves by up to 1.4% in its flanks (linear interpolation in `mu` across
-//! their bend) and by 3.4% when lit within the last interval of nodes
-//! (4.85 degrees from the normal; its peak, interpolated along the table's
-//! diagonal since 2026-12-05, by 0.15%); further analytic parts
+//! luster 2.2%, where the pairs beyond 85 degrees keep Fejer's weights); a thin sheet's transmission
+//! near the normal (thin tissue by up to 9.6% 5 to 15 degrees from it,
+//! 5.5% within 5, 3.6% further out, on the dense grid of
+//! examples/convergence.rs since 2026-12-06: the unscattered light through
+//! its rough faces, 1.5% at the nodes themselves, and the linear
+//! interpolation in `mu` across a lobe a few intervals wide; its peak,
+//! interpolated along the table's diagonal since 2026-12-05, by 0.15%);
+//! further analytic parts
 //! (unscattered transmission through rough faces, exact single scattering
 //! as its own term: the tables hold every scattering order, so `slab` has
 //! no separate `single` component); the flank of the walk's forward peak
