@@ -338,6 +338,12 @@ pub struct ProjectedFace {
     /// to more (`r_top` enters the sheet's reflection on the face's side
     /// unchanged by the adding). Empty when there is none.
     pub walk_r_top: Vec<DMatrix<f64>>,
+    /// The face's transmission per order, `(t_down, t_up)` of Walter's face
+    /// alone (normalised, without the walk's orders >= 2; the layer's own
+    /// for other faces): what a coated front's single round trip through
+    /// its coating holds on the grid ([`crate::coat_return`]), which the
+    /// `slab` model keeps analytic.
+    pub first_t: Vec<(DMatrix<f64>, DMatrix<f64>)>,
 }
 
 /// Checks the azimuth rule's points per panel: 2 to 64.
@@ -444,6 +450,7 @@ pub fn face_interface(
     }
     let single = |l: Layer| ProjectedFace {
         first_r_top: vec![l.r_top.clone(); orders],
+        first_t: vec![(l.t_down.clone(), l.t_up.clone()); orders],
         orders: vec![l; orders],
         compensation: None,
         scale: vec![1.0; outside.len() + inside.len()],
@@ -468,6 +475,7 @@ pub fn face_interface(
                 vec![1.0; outside.len() + inside.len()]
             };
             let first_r_top = orders_l.iter().map(|l| l.r_top.clone()).collect();
+            let first_t = orders_l.iter().map(|l| (l.t_down.clone(), l.t_up.clone())).collect();
             let (compensation, walk_r_top) = match scattering {
                 FaceScattering::Single => (None, Vec::new()),
                 FaceScattering::Multiple => {
@@ -481,6 +489,7 @@ pub fn face_interface(
                 first_r_top,
                 scale,
                 walk_r_top,
+                first_t,
             })
         }
     }

@@ -33,7 +33,9 @@
 //! the channels; totals for collimated light at a node and for diffuse
 //! light, from either side; the BSDF between nodes. **The model `slab`**
 //! ([`bsdf::SlabBsdf`], in core's registry as `ModelKind::Slab`, built by
-//! `paperbsdf_io`): the lit face's reflection analytic (core's face), the
+//! `paperbsdf_io`): the lit face's reflection analytic (core's face), a
+//! rough coated front's single round trip through its coating analytic
+//! ([`coat_return`]: a table of the exact integral, since 2026-12-06), the
 //! delta lobes of smooth sheets in closed form, the rest interpolated from
 //! the Fourier tables; `eval`, `sample`, `pdf` (chi-square tested),
 //! components.
@@ -51,11 +53,13 @@
 //! against the simulator: docs/accuracy_slab.md.
 //!
 //! **What is missing for issue 13.** Lobes narrower than the grid, whose
-//! peak values move by up to 10.5% when the nodes or the orders are doubled
-//! (examples/convergence.rs): a coated front smoother than the grid (the
-//! glossy preset's Beckmann 0.04, devB's 0.08: the face's own reflection is
-//! analytic, but the light the coating/base boundary returns through it
-//! near normal incidence is projected on 32 nodes), and the walk's forward
+//! values move by up to 9.6% when the nodes or the orders are doubled
+//! (examples/convergence.rs). A coated front smoother than the grid (the
+//! glossy preset's Beckmann 0.04, devB's 0.08) moved its sheet's
+//! reflection near the normal by 3.3% and 10.4% until 2026-12-06: the
+//! light the coating/base boundary returns through it was projected on 32
+//! nodes; that single round trip is now analytic ([`coat_return`]; glossy
+//! 0.01%, devB 0.03% within 15 degrees of the normal). Still missing: the walk's forward
 //! reflection at grazing incidence on a smooth face beyond 85 degrees
 //! (summed to its own 256 orders since 2026-12-05, [`interface`]: at 75
 //! degrees within 0.001% of twice the orders, 4.6-6.2% before; at 85 R -85
@@ -102,6 +106,7 @@
 //! difference of 1e-6; tests/coated.rs).
 
 pub mod bsdf;
+pub mod coat_return;
 pub mod error;
 pub mod face_walk;
 pub mod interface;
