@@ -2006,15 +2006,15 @@ impl SlabBsdf {
         // coated front reflects a delta lobe that includes the light its
         // coating/base boundary sends back (core's face reflectance): the
         // coated front's r_top. (A rough coated front's analytic reflection is
-        // the interface's alone, `face_interface_reflection`, and the light
-        // the boundary returns stays in the table.)
+        // the interface's alone, `face_interface_reflection`; the light the
+        // boundary returns in one round trip is the analytic term below, the
+        // rest stays in the table.)
         let front_smooth_coated = paper.face_is_smooth(Side::Front) && prepared.coating.is_some();
         // A rough coated front's single round trip through its coating:
         // analytic (crate::coat_return), its projection on the grid (the
         // front's Walter transmission in, the boundary's mirror, out: the
         // first term of the coated front's `r_top` in the adding) taken
-        // out of the table as the face's reflection is. Built beside the
-        // projection below, in parallel with nothing else to wait for.
+        // out of the table as the face's reflection is.
         let coat_front = match &prepared.coating {
             Some(_) if !front_smooth_coated => {
                 let (front, _) = specs[0].front.dielectric("_f")?;

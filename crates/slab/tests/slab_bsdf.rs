@@ -704,17 +704,7 @@ fn bad_input_is_an_error() {
 #[test]
 fn transmission_near_the_normal_converges() {
     let p = cases().into_iter().find(|(n, _)| *n == "thin-tissue").unwrap().1;
-    let base = SlabOptions::default();
-    let b0 = SlabBsdf::with_options(&p, &base).unwrap();
-    let b1 = SlabBsdf::with_options(
-        &p,
-        &SlabOptions {
-            nodes: 2 * base.nodes,
-            tir_nodes: 2 * base.tir_nodes,
-            ..base
-        },
-    )
-    .unwrap();
+    let (b0, b1) = support::default_and_doubled_nodes(&p);
     let (mut worst, mut worst_in) = (0.0f64, 0.0f64);
     for side in [1.0, -1.0] {
         for t in [-4.5, -3.6, -2.7, -1.8, -0.9, 0.9, 1.8, 2.7, 3.6, 4.5] {
