@@ -159,7 +159,7 @@
 
 use crate::coat_return::CoatReturn;
 use crate::error::SlabError;
-use crate::interface::walk_window;
+use crate::interface::{column_albedo, walk_window};
 use crate::slab::{Discretisation, SlabSpec, Solution};
 #[cfg(not(feature = "sse2-only"))]
 use multiversion::{multiversion, target::target_cfg_f};
@@ -2023,22 +2023,20 @@ impl SlabBsdf {
             _ => None,
         };
         let coat_proj: Vec<DMatrix<f64>> = match (&prepared.coating, &coat_front) {
-            (Some(c), Some(_)) => prepared.faces[0]
-                .first_t
-                .iter()
-                .take(m_solved)
-                .map(|(t_down, t_up)| t_up * (&c.boundary.r_top * t_down))
+            (Some(c), Some(_)) => (0..m_solved)
+                .map(|m| {
+                    let (t_down, t_up) = prepared.faces[0].first_t(m);
+                    t_up * (&c.boundary.r_top * t_down)
+                })
                 .collect(),
             _ => Vec::new(),
         };
         // The analytic term's albedo made its projection's at every node
-        // (order 0: `sum_o w_o mu_o P[o][j] / (w_j mu_j)`), so that the
+        // (order 0, `interface::column_albedo`), so that the
         // exchange moves no energy (crate::coat_return).
         let mut coat_front = coat_front;
         if let (Some(c), Some(p0)) = (coat_front.as_mut(), coat_proj.first()) {
-            let target: Vec<f64> = (0..n)
-                .map(|j| (0..n).map(|o| g.w[o] * g.mu[o] * p0[(o, j)]).sum::<f64>() / (g.w[j] * g.mu[j]))
-                .collect();
+            let target: Vec<f64> = (0..n).map(|j| column_albedo(p0, g, g, j)).collect();
             c.balance(&g.mu, &target);
         }
         let face_r = |side: usize, m: usize| -> &DMatrix<f64> {
@@ -2100,17 +2098,11 @@ impl SlabBsdf {
             };
             (0..n)
                 .map(|j| {
-                    let wj = g.w[j] * g.mu[j];
-                    let col = |k: &DMatrix<f64>| (0..n).map(|o| g.w[o] * g.mu[o] * k[(o, j)]).sum::<f64>() / wj;
-                    let r_proj = col(first);
+                    let r_proj = column_albedo(first, g, g, j);
                     // What crosses the face: its transmission and the walk's
                     // reflection, both in the table.
-                    let t_proj: f64 = (0..below.len())
-                        .map(|i| below.w[i] * below.mu[i] * layer.t_down[(i, j)])
-                        .sum::<f64>()
-                        / wj
-                        + col(&layer.r_top)
-                        - r_proj;
+                    let t_proj =
+                        column_albedo(&layer.t_down, below, g, j) + column_albedo(&layer.r_top, g, g, j) - r_proj;
                     let r_exact = face_r_at(side, g.mu[j]);
                     if t_proj > 0.0 {
                         (1.0 - (r_exact - r_proj) / t_proj).max(0.0)

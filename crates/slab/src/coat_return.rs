@@ -44,14 +44,15 @@
 //! peak at any point below 70 degrees, tests/coat_return.rs). Beyond the
 //! last `x` where the table holds more than [`CUT`] of its largest value,
 //! `eval` is 0. The table's energy follows the lobe's to about 1% (its
-//! flanks between the points: +0.6 to +1.5% for Beckmann fronts of 0.005
-//! to 0.08, up to +4.2% for a GGX 0.3 front's heavy tails, a probe of
-//! 2026-12-06) and the model `slab` makes it the projection's exactly
-//! ([`CoatReturn::balance`]: factors `r(mu_i) r(mu_o)`, reciprocal).
-//! Costs (2026-12-06): the table 100 ms and the balance 20 ms of a build
-//! on two cores, 120 kB, `eval` 30 ns (glossy's criterion `eval_grazing`
-//! 138 -> 181 ns, `eval_reflection` 66 -> 112 ns). A table of logarithms,
-//! tried, undercut the narrow lobes' energy by up to 3.9% instead and its
+//! flanks between the points: +0.6 to +1.6% for Beckmann fronts of 0.005
+//! to 0.08, up to +4.3% for a GGX 0.3 front's heavy tails) and the model
+//! `slab` makes it the projection's exactly ([`CoatReturn::balance`]:
+//! factors `r(mu_i) r(mu_o)`, reciprocal). Costs: the table 96-109 ms (41
+//! for GGX 0.3) and the balance 15-18 ms on two cores, 120 kB, `eval` 34
+//! ns (examples/coat_return.rs prints these; glossy's criterion
+//! `eval_grazing` 138 -> 181 ns, `eval_reflection` 66 -> 112 ns, benches
+//! back to back on 2026-12-06). A table of logarithms, tried,
+//! undercut the narrow lobes' energy by up to 3.9% instead and its
 //! `exp` cost 8 ns more.
 
 use paperbsdf_core::bsdf::TransportMode;
@@ -121,8 +122,9 @@ impl CoatReturn {
         // crossings: (eta - 1) m / sqrt 2 is about 1.4 times the lobe's
         // standard deviation in half-vector slope. Twice that keeps the
         // lobe's flanks off the end of the axis, where its points thin out
-        // (the narrowest lobe's energy through the table: 2.6% low at 60
-        // degrees with `sigma` itself, 1.6% with twice it).
+        // (the narrowest lobe's energy through the table, Beckmann 0.005:
+        // +1.7% at mu 0.5 and +3.5% at 0.25 with `sigma` itself, +0.9% and
+        // +1.6% with twice it; examples/coat_return.rs, the factor changed).
         let sigma = 2.0 * ((front.eta - 1.0) * front.m * std::f64::consts::FRAC_1_SQRT_2).max(1e-4);
         let mut me = CoatReturn {
             front,
@@ -135,6 +137,7 @@ impl CoatReturn {
             scale: Vec::new(),
         };
         let [nx, nd, np] = TABLE_SIZE;
+        let rule = gauss_legendre_01(TABLE_POINTS);
         let raw: Vec<f64> = (0..nx * nd * np)
             .into_par_iter()
             .map(|k| {
@@ -144,7 +147,7 @@ impl CoatReturn {
                 let cd = yd * yd;
                 let c2 = c as f64 / (np - 1) as f64;
                 match me.directions(x, cd, c2) {
-                    Some((wi, wo)) => me.exact(wi, wo, TABLE_POINTS),
+                    Some((wi, wo)) => me.integral(wi, wo, &rule),
                     None => 0.0,
                 }
             })
@@ -157,7 +160,7 @@ impl CoatReturn {
             .find(|&a| (0..nd * np).any(|k| raw[a + nx * k] > CUT * largest))
             .unwrap_or(0);
         me.x_cut = ((last + 1) as f64 / (nx - 1) as f64).min(1.0);
-        me.values = raw.iter().map(|v| v.max(0.0)).collect();
+        me.values = raw;
         Some(me)
     }
 
@@ -215,7 +218,7 @@ impl CoatReturn {
     }
 
     /// `f_c(wi, wo)` (module doc) from the table, times the energy factors
-    /// `sqrt(s(mu_i) s(mu_o))` ([`CoatReturn::balance`]); 0 unless both
+    /// `r(mu_i) r(mu_o)` ([`CoatReturn::balance`]); 0 unless both
     /// directions are above the face (the term exists for light on the
     /// coated side only).
     #[inline]
@@ -227,8 +230,8 @@ impl CoatReturn {
         v * self.scale_at(wi.z) * self.scale_at(wo.z)
     }
 
-    /// The energy factor `r = sqrt(s)` at cosine `mu` (linear between the
-    /// balance's cosines).
+    /// The energy factor `r` at cosine `mu` (linear between the balance's
+    /// cosines).
     #[inline]
     fn scale_at(&self, mu: f64) -> f64 {
         let (m, s) = (&self.scale_mu, &self.scale);
@@ -251,9 +254,9 @@ impl CoatReturn {
 
     /// Makes the albedo of [`CoatReturn::eval`] (over `wo`, by
     /// [`CoatReturn::albedo_of`]) the `target` at each cosine of `mu`
-    /// (ascending): the factors `r(mu_i) r(mu_o)` (`r = sqrt(s)` at the
-    /// cosines, linear between them), a few
-    /// symmetric fixed-point passes (the lobe is near the mirror direction,
+    /// (ascending): the factors `r(mu_i) r(mu_o)` (`r` at the cosines,
+    /// linear between them), a few symmetric fixed-point passes (each
+    /// multiplies `r` by the square root of target over albedo) (the lobe is near the mirror direction,
     /// where `mu_o` is about `mu_i`). The model `slab` gives the albedo
     /// its projection on the grid has, so that exchanging the two moves no
     /// energy; the factors correct the table's interpolation (module doc).
@@ -356,17 +359,22 @@ impl CoatReturn {
     /// on its far flanks, where `f_out` peaks away from the points, the
     /// rule thins out (tests/coat_return.rs).
     pub fn exact(&self, wi: DVec3, wo: DVec3, points: usize) -> f64 {
+        self.integral(wi, wo, &gauss_legendre_01(points))
+    }
+
+    /// [`CoatReturn::exact`] on the Gauss-Legendre rule `(u, w)` on `[0, 1]`
+    /// (the table's entries share one).
+    fn integral(&self, wi: DVec3, wo: DVec3, (u, w): &(Vec<f64>, Vec<f64>)) -> f64 {
         let Interface::Rough(mf) = self.front.interface else {
             return 0.0;
         };
         if wi.z <= 0.0 || wo.z <= 0.0 {
             return 0.0;
         }
-        let (u, w) = gauss_legendre_01(points);
         let eta = self.front.eta;
         let mut sum = 0.0;
-        for (ua, wa) in u.iter().zip(&w) {
-            for (ub, wb) in u.iter().zip(&w) {
+        for (ua, wa) in u.iter().zip(w) {
+            for (ub, wb) in u.iter().zip(w) {
                 let h = mf.sample_visible(wi, [*ua, *ub]);
                 let wh = wi.dot(h);
                 if wh <= 0.0 {
@@ -394,6 +402,6 @@ impl CoatReturn {
 
     /// Bytes held by the table.
     pub fn memory_bytes(&self) -> usize {
-        (self.values.len() + self.scale.len() + self.scale_mu.len()) * std::mem::size_of::<f64>()
+        (self.values.len() + self.scale.len() + self.scale_mu.len()) * std::mem::size_of::<f64>() + self.guide.len() * 2
     }
 }

@@ -338,12 +338,25 @@ pub struct ProjectedFace {
     /// to more (`r_top` enters the sheet's reflection on the face's side
     /// unchanged by the adding). Empty when there is none.
     pub walk_r_top: Vec<DMatrix<f64>>,
-    /// The face's transmission per order, `(t_down, t_up)` of Walter's face
-    /// alone (normalised, without the walk's orders >= 2; the layer's own
-    /// for other faces): what a coated front's single round trip through
+    /// Walter's transmission per order, `(t_down, t_up)` (normalised,
+    /// without the walk's orders >= 2), kept where the walk was added to
+    /// [`ProjectedFace::orders`]; empty where those are Walter's face's own
+    /// ([`ProjectedFace::first_t`]).
+    walk_free_t: Vec<(DMatrix<f64>, DMatrix<f64>)>,
+}
+
+impl ProjectedFace {
+    /// The face's first transmission in order `m`, `(t_down, t_up)`: Walter's
+    /// face alone (normalised, without the walk's orders >= 2; the layer's
+    /// own for other faces). What a coated front's single round trip through
     /// its coating holds on the grid ([`crate::coat_return`]), which the
     /// `slab` model keeps analytic.
-    pub first_t: Vec<(DMatrix<f64>, DMatrix<f64>)>,
+    pub fn first_t(&self, m: usize) -> (&DMatrix<f64>, &DMatrix<f64>) {
+        match self.walk_free_t.get(m) {
+            Some((down, up)) => (down, up),
+            None => (&self.orders[m].t_down, &self.orders[m].t_up),
+        }
+    }
 }
 
 /// Checks the azimuth rule's points per panel: 2 to 64.
@@ -450,7 +463,7 @@ pub fn face_interface(
     }
     let single = |l: Layer| ProjectedFace {
         first_r_top: vec![l.r_top.clone(); orders],
-        first_t: vec![(l.t_down.clone(), l.t_up.clone()); orders],
+        walk_free_t: Vec::new(),
         orders: vec![l; orders],
         compensation: None,
         scale: vec![1.0; outside.len() + inside.len()],
@@ -475,12 +488,12 @@ pub fn face_interface(
                 vec![1.0; outside.len() + inside.len()]
             };
             let first_r_top = orders_l.iter().map(|l| l.r_top.clone()).collect();
-            let first_t = orders_l.iter().map(|l| (l.t_down.clone(), l.t_up.clone())).collect();
-            let (compensation, walk_r_top) = match scattering {
-                FaceScattering::Single => (None, Vec::new()),
+            let (compensation, walk_r_top, walk_free_t) = match scattering {
+                FaceScattering::Single => (None, Vec::new(), Vec::new()),
                 FaceScattering::Multiple => {
+                    let walk_free_t = orders_l.iter().map(|l| (l.t_down.clone(), l.t_up.clone())).collect();
                     let (c, r) = add_walk(bd, outside, inside, &mut orders_l, azimuth_points, walk_orders)?;
-                    (Some(c), r)
+                    (Some(c), r, walk_free_t)
                 }
             };
             Ok(ProjectedFace {
@@ -489,7 +502,7 @@ pub fn face_interface(
                 first_r_top,
                 scale,
                 walk_r_top,
-                first_t,
+                walk_free_t,
             })
         }
     }
@@ -792,8 +805,9 @@ fn unresolved() -> SlabError {
     }
 }
 
-/// Flux albedo `sum_o w_o mu_o K[o][j] / (w_j mu_j)` of column `j` of `k` on output grid `to`.
-fn column_albedo(k: &DMatrix<f64>, to: &Grid, from: &Grid, j: usize) -> f64 {
+/// Flux albedo `sum_o w_o mu_o K[o][j] / (w_j mu_j)` of column `j` of `k` on output grid `to`
+/// (`from` the grid of `j`): the fraction of collimated light's flux at node `j` that `k` sends out.
+pub(crate) fn column_albedo(k: &DMatrix<f64>, to: &Grid, from: &Grid, j: usize) -> f64 {
     (0..to.len()).map(|o| to.w[o] * to.mu[o] * k[(o, j)]).sum::<f64>() / (from.w[j] * from.mu[j])
 }
 

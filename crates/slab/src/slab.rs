@@ -32,7 +32,7 @@
 
 use crate::error::SlabError;
 use crate::interface::{
-    face_interface, smooth_boundary, Compensation, ProjectedFace, Projection, DEFAULT_AZIMUTH_POINTS,
+    column_albedo, face_interface, smooth_boundary, Compensation, ProjectedFace, Projection, DEFAULT_AZIMUTH_POINTS,
 };
 use crate::layer::{default_start_thickness, medium_layer, Layer};
 use crate::phase::{phase_fourier, validate, PhaseFourier};
@@ -431,10 +431,7 @@ impl Solution {
     pub fn totals_collimated(&self, side: Side, j: usize) -> (f64, f64) {
         let g = &self.outside;
         let (r, t) = self.rt0(side);
-        let flux = |k: &nalgebra::DMatrix<f64>| -> f64 {
-            (0..g.len()).map(|o| g.w[o] * g.mu[o] * k[(o, j)]).sum::<f64>() / (g.w[j] * g.mu[j])
-        };
-        (flux(r), flux(t))
+        (column_albedo(r, g, g, j), column_albedo(t, g, g, j))
     }
     /// Totals for collimated light at normal incidence (the Radau node `mu = 1`).
     pub fn totals_normal(&self, side: Side) -> (f64, f64) {
