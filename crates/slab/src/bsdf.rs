@@ -19,7 +19,7 @@
 //!   order, so nothing is counted twice;
 //! - for a rough coated front (`eta_f != eta_b`), the light its coating/base
 //!   boundary mirrors back through it in one round trip
-//!   ([`crate::coat_return`], part of [`Component::Direct`]): for a front
+//!   ([`crate::two_crossings`], part of [`Component::Direct`]): for a front
 //!   smoother than the grid a lobe about the mirror direction narrower than
 //!   the last interval of nodes (glossy's and devB's reflection near the
 //!   normal moved by 3.3% and 10.4% with twice the nodes while it was on the
@@ -29,9 +29,23 @@
 //!   the adding, [`crate::interface::ProjectedFace::first_t`]) is
 //!   subtracted from the table as the face's reflection is, and the
 //!   analytic term's energy made its projection's at every node
-//!   ([`CoatReturn::balance`]), so the exchange moves no energy. It has no
+//!   ([`TwoCrossings::balance`]), so the exchange moves no energy. It has no
 //!   sampling lobe of its own: the face's lobe (about 2.5 times wider in
 //!   half-vector slope) and the table's cosine share cover it;
+//! - for an uncoated sheet with two rough faces, its unscattered
+//!   transmission ([`crate::two_crossings`], per distinct optical
+//!   thickness, part of [`Component::Direct`]; since 2026-12-06): a lobe
+//!   about the straight-through direction as narrow as the faces make it,
+//!   which on the grid moved thin tissue's transmission 5-15 degrees from
+//!   the normal by 9.6% with twice the nodes (1.5% with the term; weak
+//!   scatter 4.5% -> 0.9%, examples/convergence.rs). Its projection (`t`
+//!   of the exit face, the unscattered medium's diagonal, `t` of the lit
+//!   face: the first term of the sheet's transmission in the adding) is
+//!   subtracted from the table, the term balanced to it at and between the
+//!   nodes, and what the term still misses at a node given to the table's
+//!   balance (module doc of [`crate::two_crossings`], "Energy"). Not where
+//!   `exp(-tau)` is below [`UNSCATTERED_FLOOR`]. Sampled with the table:
+//!   its cells' densities include it;
 //! - for two smooth faces, the unscattered light: mirror-like internal
 //!   reflections and straight-through transmission are delta lobes, in
 //!   closed form (equal indices: `T = (1-F)^2 a / (1 - F^2 a^2)`, internal
@@ -42,7 +56,7 @@
 //!   matrices), and it is subtracted.
 //!
 //! Everything else (light that entered the sheet: scattered once or more,
-//! and the unscattered light through a rough face) is the **table**: per side
+//! and the unscattered light through one rough face and one smooth) is the **table**: per side
 //! of incidence, reflection or transmission, outgoing node `o`, incident node
 //! `j` and Fourier order `m`, the coefficient
 //! `c_m[o][j] = (2 - [m = 0]) K_m[o][j] / (2 pi w_j mu_j)` of the solution's
@@ -157,10 +171,11 @@
 //! [`Component::Multiple`], which here is **every scattering order**, single
 //! scattering included (`slab` does not split orders 1 and 2+).
 
-use crate::coat_return::CoatReturn;
 use crate::error::SlabError;
 use crate::interface::{column_albedo, walk_window};
+use crate::quad::Grid;
 use crate::slab::{Discretisation, SlabSpec, Solution};
+use crate::two_crossings::{Between, TwoCrossings};
 #[cfg(not(feature = "sse2-only"))]
 use multiversion::{multiversion, target::target_cfg_f};
 use nalgebra::DMatrix;
@@ -798,9 +813,24 @@ pub struct SlabBsdf {
     /// in the interval's fraction ([`interval_cubics`]; empty for a smooth face).
     face_polys: [Vec<[f64; 4]>; 2],
     /// A rough coated front's single round trip through its coating
-    /// ([`crate::coat_return`]), analytic; `None` for other sheets.
-    coat: Option<CoatReturn>,
+    /// ([`crate::two_crossings`]), analytic; `None` for other sheets.
+    coat: Option<TwoCrossings>,
+    /// Per distinct medium: the unscattered transmission through two rough
+    /// faces of an uncoated sheet ([`crate::two_crossings`]), analytic;
+    /// `None` for other sheets.
+    unscattered: Vec<Option<TwoCrossings>>,
+    /// Per colour channel: its medium's index in `unscattered`.
+    solution_of: [usize; 3],
 }
+
+/// Below this `exp(-tau)` (optical thickness above 11.5) a sheet's
+/// unscattered transmission is left to the table, where it was resolved
+/// well enough: devA (thickness 12, GGX 0.35 faces) moved by 0.10% at
+/// most with twice the nodes with the analytic term and without it
+/// (examples/convergence.rs, 2026-12-06), and the term's table costs
+/// 0.1-0.2 s of a build (smooth front's unequal faces 0.55 -> 0.77 s with
+/// a floor of 1e-12, for light 3e-7 of the incident).
+pub const UNSCATTERED_FLOOR: f64 = 1e-5;
 
 /// Panels per axis of [`face_albedo`]'s rule in the model's build (each
 /// with [`FACE_ALBEDO_POINTS`] Gauss-Legendre points): within 4.1e-5 of
@@ -959,6 +989,24 @@ fn crossing_shape(mu: &[f64], r: impl Fn(f64) -> f64) -> Vec<f64> {
     g
 }
 
+/// The crossing shape of [`crossing_shape`] at any `mu` directly (not
+/// tabulated): `(1 - r(mu))` over its linear interpolation between the
+/// nodes (below the smallest node, over its value there; 1 at and above
+/// the last).
+fn crossing_shape_at(mu: &[f64], r: impl Fn(f64) -> f64, m: f64) -> f64 {
+    let n = mu.len();
+    let ratio = |exact: f64, lin: f64| if lin > 0.0 && exact > 0.0 { exact / lin } else { 1.0 };
+    if m >= mu[n - 1] {
+        return 1.0;
+    }
+    if m < mu[0] {
+        return ratio(1.0 - r(m.max(1e-9)), 1.0 - r(mu[0]));
+    }
+    let i = mu.partition_point(|&x| x <= m).saturating_sub(1).min(n - 2);
+    let t = (m - mu[i]) / (mu[i + 1] - mu[i]);
+    ratio(1.0 - r(m), (1.0 - r(mu[i])) * (1.0 - t) + (1.0 - r(mu[i + 1])) * t)
+}
+
 /// The crossing shape `g` at `mu`, placed among the nodes at `(i, t)` by
 /// [`locate`] (linear between the points of [`crossing_shape`]).
 #[inline]
@@ -1066,12 +1114,13 @@ fn interpolant_weights(mu: &[f64], g: &[f64]) -> Vec<f64> {
 fn balance_interpolation(
     table: &mut [[Vec<Rgb>; 2]; 2],
     direct: &mut [[Vec<Rgb>; 2]; 2],
-    mu: &[f64],
-    w: &[f64],
+    grid: &Grid,
     cross: &[Vec<f64>; 2],
     shape: &[[Vec<f64>; 3]; 2],
+    adjust: &[[Vec<Rgb>; 2]; 2],
     orders: usize,
 ) -> ([Vec<Rgb>; 2], [[Vec<Rgb>; 2]; 2]) {
+    let (mu, w) = (&grid.mu[..], &grid.w[..]);
     let n = mu.len();
     let q: Vec<f64> = (0..n).map(|o| 2.0 * PI * w[o] * mu[o]).collect();
     let c0 = |tab: &[[Vec<Rgb>; 2]; 2], s: usize, t: usize, o: usize, j: usize, c: usize| {
@@ -1102,6 +1151,7 @@ fn balance_interpolation(
                                 }
                             })
                             .sum::<f64>()
+                            + adjust[t][s][j].0[c]
                     })
                     .collect()
             })
@@ -2011,14 +2061,14 @@ impl SlabBsdf {
         // rest stays in the table.)
         let front_smooth_coated = paper.face_is_smooth(Side::Front) && prepared.coating.is_some();
         // A rough coated front's single round trip through its coating:
-        // analytic (crate::coat_return), its projection on the grid (the
+        // analytic (crate::two_crossings), its projection on the grid (the
         // front's Walter transmission in, the boundary's mirror, out: the
         // first term of the coated front's `r_top` in the adding) taken
         // out of the table as the face's reflection is.
         let coat_front = match &prepared.coating {
             Some(_) if !front_smooth_coated => {
                 let (front, _) = specs[0].front.dielectric("_f")?;
-                CoatReturn::new(front, specs[0].back.eta() / specs[0].front.eta())
+                TwoCrossings::coat_return(front, specs[0].back.eta() / specs[0].front.eta())
             }
             _ => None,
         };
@@ -2031,13 +2081,56 @@ impl SlabBsdf {
                 .collect(),
             _ => Vec::new(),
         };
-        // The analytic term's albedo made its projection's at every node
-        // (order 0, `interface::column_albedo`), so that the
-        // exchange moves no energy (crate::coat_return).
-        let mut coat_front = coat_front;
-        if let (Some(c), Some(p0)) = (coat_front.as_mut(), coat_proj.first()) {
-            let target: Vec<f64> = (0..n).map(|j| column_albedo(p0, g, g, j)).collect();
-            c.balance(&g.mu, &target);
+        // An uncoated sheet with two rough faces: its unscattered
+        // transmission (through the lit face, straight through the medium,
+        // out through the other face) analytic as well, per distinct medium
+        // (crate::two_crossings), its projection (`t` of the exit face,
+        // the unscattered medium's diagonal, `t` of the lit face: the first
+        // term of the sheet's transmission in the adding) taken out of the
+        // table. Not where `exp(-tau)` is below UNSCATTERED_FLOOR (nothing
+        // comes through; the projection is as small).
+        let two_rough = !paper.face_is_smooth(Side::Front) && !paper.face_is_smooth(Side::Back);
+        let mut unscattered: Vec<Option<TwoCrossings>> = Vec::new();
+        let mut unscattered_proj: Vec<[Vec<DMatrix<f64>>; 2]> = Vec::new();
+        for (k, (_, unsc)) in solutions.iter().enumerate() {
+            let c = solution_of.iter().position(|&x| x == k).unwrap_or(0);
+            let tau = specs[c].medium.tau;
+            // Media that differ only in their albedo share the term.
+            let same_tau = unscattered
+                .iter()
+                .flatten()
+                .find(|t: &&TwoCrossings| t.between() == Between::Straight { tau })
+                .cloned();
+            let term = if same_tau.is_some() {
+                same_tau
+            } else if prepared.coating.is_none() && two_rough && (-tau).exp() > UNSCATTERED_FLOOR {
+                let (front, _) = specs[0].front.dielectric("_f")?;
+                let (back, _) = specs[0].back.dielectric("_b")?;
+                TwoCrossings::unscattered(front, back, tau)
+            } else {
+                None
+            };
+            let proj = match term {
+                Some(_) => {
+                    let [f, b] = &prepared.faces;
+                    let through =
+                        |m: usize, lit: &crate::interface::ProjectedFace, exit: &crate::interface::ProjectedFace| {
+                            let d = unsc.medium[m].t_down.diagonal();
+                            let mut inner = lit.first_t(m).0.clone();
+                            for (mut row, di) in inner.row_iter_mut().zip(d.iter()) {
+                                row *= *di;
+                            }
+                            exit.first_t(m).1 * inner
+                        };
+                    [
+                        (0..m_solved).map(|m| through(m, f, b)).collect(),
+                        (0..m_solved).map(|m| through(m, b, f)).collect(),
+                    ]
+                }
+                None => [Vec::new(), Vec::new()],
+            };
+            unscattered.push(term);
+            unscattered_proj.push(proj);
         }
         let face_r = |side: usize, m: usize| -> &DMatrix<f64> {
             match (&prepared.coating, side) {
@@ -2113,6 +2206,73 @@ impl SlabBsdf {
                 .collect()
         };
         let cross = [crossing(Side::Front), crossing(Side::Back)];
+        // The analytic terms' albedo made their projection's at every node
+        // (order 0, `sum_o w_o mu_o P[o][j] / (w_j mu_j)`, with the
+        // crossings' factors `s(o) s(j)` of the two faces the light crosses
+        // outside: targets that carry the same flux both ways), and between
+        // the nodes the shape the table's interpolation gives its own
+        // albedo there (the lit face's crossing shape times the linear
+        // interpolation; module doc, "Energy"), so that the exchange moves
+        // no energy (crate::two_crossings). What the analytic term then
+        // misses at a node (its table's interpolation, targets a common
+        // scale cannot meet both ways) goes to the table's balance below.
+        let albedo0 = |p0: &DMatrix<f64>, lit: usize, exit: usize| -> Vec<f64> {
+            (0..n)
+                .map(|j| {
+                    (0..n)
+                        .map(|o| g.w[o] * g.mu[o] * p0[(o, j)] * cross[exit][o])
+                        .sum::<f64>()
+                        * cross[lit][j]
+                        / (g.w[j] * g.mu[j])
+                })
+                .collect()
+        };
+        let shape_of = |side: Side| move |m: f64| crossing_shape_at(&g.mu, |x| face_r_at(side, x), m);
+        let (shape_front, shape_back) = (shape_of(Side::Front), shape_of(Side::Back));
+        let mut coat_front = coat_front;
+        if let (Some(c), Some(p0)) = (coat_front.as_mut(), coat_proj.first()) {
+            let target = albedo0(p0, 0, 0);
+            c.balance(&g.mu, &target, &target, None);
+        }
+        for (term, proj) in unscattered.iter_mut().zip(&unscattered_proj) {
+            if let (Some(t), Some(pf), Some(pb)) = (term.as_mut(), proj[0].first(), proj[1].first()) {
+                let (t1, t2) = (albedo0(pf, 0, 1), albedo0(pb, 1, 0));
+                t.balance(&g.mu, &t1, &t2, Some([&shape_front, &shape_back]));
+            }
+        }
+        // Per [reflection, transmission][side][node] and channel: what the
+        // table's balance targets besides its own quadrature albedo, the
+        // projections' albedo as the table lost it (`s(j) sum_o w_o mu_o
+        // P[o][j] / (w_j mu_j)`, the exit's crossing factor divided out as
+        // in the table's targets) less the analytic terms' albedo at the
+        // node by their own rule.
+        let mut adjust: [[Vec<Rgb>; 2]; 2] = std::array::from_fn(|_| std::array::from_fn(|_| vec![Rgb::ZERO; n]));
+        let lost = |p0: &DMatrix<f64>, lit: usize, j: usize| cross[lit][j] * column_albedo(p0, g, g, j);
+        if let (Some(c), Some(p0)) = (coat_front.as_ref(), coat_proj.first()) {
+            for (j, (a, &m)) in adjust[0][0].iter_mut().zip(&g.mu).enumerate() {
+                *a = Rgb::splat(lost(p0, 0, j) - c.albedo_of(m, |a, b| c.eval(a, b)));
+            }
+        }
+        for (k, (term, proj)) in unscattered.iter().zip(&unscattered_proj).enumerate() {
+            if let (Some(t), Some(pf), Some(pb)) = (term.as_ref(), proj[0].first(), proj[1].first()) {
+                let per_node: Vec<[f64; 2]> =
+                    g.mu.par_iter()
+                        .enumerate()
+                        .map(|(j, &m)| {
+                            [
+                                lost(pf, 0, j) - t.albedo_of(m, |a, b| t.eval(a, b)),
+                                lost(pb, 1, j) - t.albedo_of(m, |a, b| t.eval(b, a)),
+                            ]
+                        })
+                        .collect();
+                for (c, _) in solution_of.iter().enumerate().filter(|(_, &x)| x == k) {
+                    for (j, d) in per_node.iter().enumerate() {
+                        adjust[1][0][j].0[c] = d[0];
+                        adjust[1][1][j].0[c] = d[1];
+                    }
+                }
+            }
+        }
         // A grey sheet: every channel is the same solution.
         let grey = solution_of.iter().all(|&k| k == solution_of[0]);
         let mut table: [[Vec<Rgb>; 2]; 2] = Default::default();
@@ -2148,7 +2308,7 @@ impl SlabBsdf {
                                     (kf[(o, j)] - ku[(o, j)], 0.0)
                                 } else {
                                     let surface = if transmit {
-                                        0.0
+                                        unscattered_proj[k][side].get(m).map_or(0.0, |p| p[(o, j)])
                                     } else {
                                         face_r(side, m)[(o, j)]
                                             + coat_proj.get(m).filter(|_| side == 0).map_or(0.0, |k| k[(o, j)])
@@ -2271,7 +2431,7 @@ impl SlabBsdf {
         let mut shape = linear_shape.clone().map(|g| [g.clone(), g.clone(), g]);
         let unbalanced = (table.clone(), direct.clone());
         let (mut balance, mut split) =
-            balance_interpolation(&mut table, &mut direct, &g.mu, &g.w, &cross, &shape, m_solved);
+            balance_interpolation(&mut table, &mut direct, g, &cross, &shape, &adjust, m_solved);
         // The triangles' albedo between the nodes of `mu_i` (ridge_ratios),
         // folded into the crossing shapes, which changes the exit weights of
         // the balance: the solution rebalanced, a few passes.
@@ -2285,7 +2445,7 @@ impl SlabBsdf {
                 }
             }
             (table, direct) = unbalanced.clone();
-            (balance, split) = balance_interpolation(&mut table, &mut direct, &g.mu, &g.w, &cross, &shape, m_solved);
+            (balance, split) = balance_interpolation(&mut table, &mut direct, g, &cross, &shape, &adjust, m_solved);
         }
         // The walk's orders past the solution's, balanced as the rest of
         // their pairs (factors x_o x_j and the reflection's split factors on the lit side), joined to the
@@ -2354,6 +2514,8 @@ impl SlabBsdf {
             split,
             face_polys,
             coat: coat_front,
+            unscattered,
+            solution_of,
         };
         for side in Side::BOTH {
             let (cells, albedo): (Vec<CellDensity>, Vec<f64>) =
@@ -2386,7 +2548,10 @@ impl SlabBsdf {
                     // wi toward the light: propagation azimuth differs by phi
                     // from wo's, so wi's azimuth is pi + phi (module doc).
                     let wi = DVec3::new(-s * phi.cos(), -s * phi.sin(), z_sign * mu);
-                    edge.push(self.eval_table(&self.table, wo, wi).mean().max(0.0) * mu);
+                    // The analytic unscattered transmission is drawn from
+                    // the cells with the table.
+                    let f = self.eval_table(&self.table, wo, wi).mean().max(0.0) + self.unscattered_at(wo, wi).mean();
+                    edge.push(f * mu);
                 }
             }
         }
@@ -2550,7 +2715,17 @@ impl SlabBsdf {
             .iter()
             .map(|d| d.len() * std::mem::size_of::<[f64; 4]>())
             .sum();
-        tables + cells + shapes + balance + face_polys + self.coat.as_ref().map_or(0, CoatReturn::memory_bytes)
+        tables
+            + cells
+            + shapes
+            + balance
+            + face_polys
+            + self
+                .coat
+                .iter()
+                .chain(self.unscattered.iter().flatten())
+                .map(TwoCrossings::memory_bytes)
+                .sum::<usize>()
     }
 
     /// The lobe probabilities at `wo`: (surface lobe, delta lobes, table).
@@ -2688,11 +2863,81 @@ impl SlabBsdf {
         Some((DVec3::new(s * x, s * y, z * mu), Some(CellPlace { e, x: x_phi })))
     }
 
-    /// The coated front's single round trip at `(wi, wo)` ([`crate::coat_return`];
+    /// The coated front's single round trip at `(wi, wo)` ([`crate::two_crossings`];
     /// 0 for other sheets and off the coated side).
     #[inline]
     fn coat_at(&self, wi: DVec3, wo: DVec3) -> f64 {
         self.coat.as_ref().map_or(0.0, |c| c.eval(wi, wo))
+    }
+
+    /// The unscattered transmission at `(wi, wo)` on opposite sides
+    /// ([`crate::two_crossings`]; 0 for other sheets and in reflection), per
+    /// channel: light from the front is the table's first crossing, light
+    /// from the back is the same by reciprocity with the directions
+    /// exchanged (both are passed above their faces: the exit direction
+    /// flipped).
+    #[inline]
+    fn unscattered_at(&self, wi: DVec3, wo: DVec3) -> Rgb {
+        if wi.z * wo.z >= 0.0 || self.unscattered.iter().all(Option::is_none) {
+            return Rgb::ZERO;
+        }
+        let flip = |w: DVec3| DVec3::new(w.x, w.y, -w.z);
+        let at = |t: &TwoCrossings| {
+            if wi.z > 0.0 {
+                t.eval(wi, flip(wo))
+            } else {
+                t.eval(wo, flip(wi))
+            }
+        };
+        // At most one term per channel (no allocation in `eval`).
+        let mut v = [0.0; 3];
+        for (v, t) in v.iter_mut().zip(&self.unscattered) {
+            *v = t.as_ref().map_or(0.0, at);
+        }
+        Rgb(self.solution_of.map(|k| v[k]))
+    }
+
+    /// The terms kept analytic besides the lit face's reflection at
+    /// `(wi, wo)`: a rough coated front's round trip through its coating
+    /// (reflection on the front) and the unscattered transmission through
+    /// two rough faces ([`crate::two_crossings`]), per channel; part of
+    /// `eval` and of component `direct`. Lobes narrower than the grid: a
+    /// rule that integrates the table may not resolve them
+    /// ([`SlabBsdf::analytic_albedo`] does).
+    pub fn analytic_at(&self, wi: DVec3, wo: DVec3) -> Rgb {
+        if wi.z == 0.0 || wo.z == 0.0 {
+            return Rgb::ZERO;
+        }
+        Rgb::splat(self.coat_at(wi, wo)) + self.unscattered_at(wi, wo)
+    }
+
+    /// The directional albedo of [`SlabBsdf::analytic_at`] for light from
+    /// `wi`, `(reflection, transmission)` per channel, by a rule in the
+    /// lobes' own half-vector coordinates
+    /// ([`crate::two_crossings::TwoCrossings::albedo_of`]).
+    pub fn analytic_albedo(&self, wi: DVec3) -> (Rgb, Rgb) {
+        if wi.z == 0.0 {
+            return (Rgb::ZERO, Rgb::ZERO);
+        }
+        let mu = wi.z.abs();
+        let r = match (&self.coat, wi.z > 0.0) {
+            (Some(c), true) => c.albedo_of(mu, |a, b| c.eval(a, b)),
+            _ => 0.0,
+        };
+        let t: Vec<f64> = self
+            .unscattered
+            .iter()
+            .map(|t| {
+                t.as_ref().map_or(0.0, |t| {
+                    if wi.z > 0.0 {
+                        t.albedo_of(mu, |a, b| t.eval(a, b))
+                    } else {
+                        t.albedo_of(mu, |a, b| t.eval(b, a))
+                    }
+                })
+            })
+            .collect();
+        (Rgb::splat(r), Rgb(self.solution_of.map(|k| t[k])))
     }
 
     /// The continuous part of `f` (the table, clamped at 0, plus the analytic surface reflection).
@@ -2707,7 +2952,7 @@ impl SlabBsdf {
         if wi.z * wo.z > 0.0 {
             table + Rgb::splat(self.paper.face_interface_reflection(Side::of(wi), wi, wo) + self.coat_at(wi, wo))
         } else {
-            table
+            table + self.unscattered_at(wi, wo)
         }
     }
 }
@@ -2771,7 +3016,8 @@ impl Bsdf for SlabBsdf {
         }
         let wi_at = self.place(wi);
         let f = self.eval_table_at(&self.table, wi_at, wo_at, c).map(|x| x.max(0.0))
-            + Rgb::splat(face_f + self.coat_at(wi, wo));
+            + Rgb::splat(face_f + self.coat_at(wi, wo))
+            + self.unscattered_at(wi, wo);
         let flags = if wi.z * wo.z > 0.0 {
             BsdfFlags::REFLECTION
                 | if lobe == 0 {
@@ -2818,7 +3064,9 @@ impl ComponentModel for SlabBsdf {
                 }
             }
             Component::Direct => {
-                self.eval_table(&self.direct, wi, wo).map(|x| x.max(0.0)) + Rgb::splat(self.coat_at(wi, wo))
+                self.eval_table(&self.direct, wi, wo).map(|x| x.max(0.0))
+                    + Rgb::splat(self.coat_at(wi, wo))
+                    + self.unscattered_at(wi, wo)
             }
             Component::Multiple => {
                 (self.eval_table(&self.table, wi, wo) - self.eval_table(&self.direct, wi, wo)).map(|x| x.max(0.0))

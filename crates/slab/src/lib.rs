@@ -34,8 +34,10 @@
 //! light, from either side; the BSDF between nodes. **The model `slab`**
 //! ([`bsdf::SlabBsdf`], in core's registry as `ModelKind::Slab`, built by
 //! `paperbsdf_io`): the lit face's reflection analytic (core's face), a
-//! rough coated front's single round trip through its coating analytic
-//! ([`coat_return`]: a table of the exact integral, since 2026-12-06), the
+//! rough coated front's single round trip through its coating and an
+//! uncoated sheet's unscattered transmission through two rough faces
+//! analytic ([`two_crossings`]: tables of the exact integrals, since
+//! 2026-12-06), the
 //! delta lobes of smooth sheets in closed form, the rest interpolated from
 //! the Fourier tables; `eval`, `sample`, `pdf` (chi-square tested),
 //! components.
@@ -53,27 +55,21 @@
 //! against the simulator: docs/accuracy_slab.md.
 //!
 //! **What is missing for issue 13.** Lobes narrower than the grid, whose
-//! values move by up to 9.6% when the nodes or the orders are doubled
-//! (examples/convergence.rs). A coated front smoother than the grid (the
-//! glossy preset's Beckmann 0.04, devB's 0.08) moved its sheet's
-//! reflection near the normal by 3.3% and 10.4% until 2026-12-06: the
-//! light the coating/base boundary returns through it was projected on 32
-//! nodes; that single round trip is now analytic ([`coat_return`]; glossy
-//! 0.01%, devB 0.03% within 15 degrees of the normal). Still missing: the walk's forward
-//! reflection at grazing incidence on a smooth face beyond 85 degrees
-//! (summed to its own 256 orders since 2026-12-05, [`interface`]: at 75
-//! degrees within 0.001% of twice the orders, 4.6-6.2% before; at 85 R -85
-//! luster 2.2%, where the pairs beyond 85 degrees keep Fejer's weights); a thin sheet's transmission
-//! near the normal (thin tissue by up to 9.6% 5 to 15 degrees from it,
-//! 5.5% within 5, 3.6% further out, on the dense grid of
-//! examples/convergence.rs since 2026-12-06: the unscattered light through
-//! its rough faces, 1.5% at the nodes themselves, and the linear
-//! interpolation in `mu` across a lobe a few intervals wide; its peak,
-//! interpolated along the table's diagonal since 2026-12-05, by 0.15%);
-//! further analytic parts
-//! (unscattered transmission through rough faces, exact single scattering
-//! as its own term: the tables hold every scattering order, so `slab` has
-//! no separate `single` component); the flank of the walk's forward peak
+//! values move by up to 10.4% when the nodes or the orders are doubled
+//! (examples/convergence.rs), were made analytic on 2026-12-06: a coated
+//! front's round trip through its coating (glossy 3.3% -> 0.01%, devB
+//! near the normal 10.4% -> 0.03%) and an uncoated sheet's unscattered
+//! transmission through two rough faces (thin tissue 9.6% -> 1.5%, weak
+//! scatter 4.5% -> 0.9%) ([`two_crossings`]). Still missing: a thin
+//! sheet's scattered transmission near the normal, interpolated linearly
+//! in `mu` across a lobe a few intervals wide (the 1.5% and 0.9%); the
+//! walk's forward reflection at grazing incidence on a smooth face beyond
+//! 85 degrees (summed to its own 256 orders since 2026-12-05,
+//! [`interface`]: at 75 degrees within 0.001% of twice the orders, 4.6-6.2%
+//! before; at 85 R -85 luster 2.2%, where the pairs beyond 85 degrees keep
+//! Fejer's weights); exact single scattering as its own term (the tables
+//! hold every scattering order, so `slab` has no separate `single`
+//! component); the flank of the walk's forward peak
 //! at grazing angles off a Beckmann 0.15 face, interpolated linearly in
 //! `mu_o` between 32 nodes (luster at 75 R -65: 0.34% from twice the
 //! nodes; at the nodes themselves within 0.04%).
@@ -106,7 +102,6 @@
 //! difference of 1e-6; tests/coated.rs).
 
 pub mod bsdf;
-pub mod coat_return;
 pub mod error;
 pub mod face_walk;
 pub mod interface;
@@ -115,6 +110,7 @@ mod linalg;
 pub mod phase;
 pub mod quad;
 pub mod slab;
+pub mod two_crossings;
 
 pub use bsdf::{face_albedo, SlabBsdf, SlabOptions};
 pub use error::SlabError;

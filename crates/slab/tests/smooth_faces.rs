@@ -50,9 +50,14 @@ fn thin(sigma_a: f64, front: (f64, Distribution), back: (f64, Distribution)) -> 
 
 /// `(R, T)` of `slab` for light from `wi`: the table (components `direct`
 /// and `multiple`) by [`grid_albedo`] on each hemisphere, plus the lit
-/// face's reflectance as `slab` takes it (`SlabBsdf::face_reflectance`).
+/// face's reflectance as `slab` takes it (`SlabBsdf::face_reflectance`);
+/// the analytic unscattered transmission (in `direct`, a lobe as narrow as
+/// the faces, which a rule on the grid's intervals does not resolve) by its
+/// own rule (`SlabBsdf::analytic_albedo`).
 fn totals(b: &SlabBsdf, wi: DVec3) -> (f64, f64) {
-    let table = |wo: DVec3| (b.eval(wi, wo) - b.eval_component(wi, wo, Component::Surface)).mean();
+    let table =
+        |wo: DVec3| (b.eval(wi, wo) - b.eval_component(wi, wo, Component::Surface) - b.analytic_at(wi, wo)).mean();
+    let (r_analytic, t_analytic) = b.analytic_albedo(wi);
     let half = |reflect: bool| {
         grid_albedo(
             |wo| if (wo.z * wi.z > 0.0) == reflect { table(wo) } else { 0.0 },
@@ -64,7 +69,10 @@ fn totals(b: &SlabBsdf, wi: DVec3) -> (f64, f64) {
         )
     };
     let side = if wi.z > 0.0 { Side::Front } else { Side::Back };
-    (half(true) + b.face_reflectance(side, wi.z.abs()), half(false))
+    (
+        half(true) + b.face_reflectance(side, wi.z.abs()) + r_analytic.mean(),
+        half(false) + t_analytic.mean(),
+    )
 }
 
 fn dir(theta_deg: f64, side: f64) -> DVec3 {

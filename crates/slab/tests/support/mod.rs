@@ -1,8 +1,11 @@
 //! What the slab crate's integration tests share: the reciprocity measure of
 //! a layer's matrices, the simulator's totals for collimated light, a
 //! deterministic rule for the integral of a BSDF over the outgoing
-//! direction, and a sheet built with the default and with twice the nodes.
+//! direction, a sheet built with the default and with twice the nodes, and
+//! the directions around the lobes of `two_crossings` ([`lobe_points`]).
 #![allow(dead_code)]
+
+pub mod lobe_points;
 
 use nalgebra::DMatrix;
 use paperbsdf_core::DVec3;
