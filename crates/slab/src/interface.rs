@@ -349,8 +349,9 @@ impl ProjectedFace {
     /// The face's first transmission in order `m`, `(t_down, t_up)`: Walter's
     /// face alone (normalised, without the walk's orders >= 2; the layer's
     /// own for other faces). What a coated front's single round trip through
-    /// its coating holds on the grid ([`crate::two_crossings`]), which the
-    /// `slab` model keeps analytic.
+    /// its coating, and a sheet's unscattered transmission through two rough
+    /// faces, hold on the grid ([`crate::two_crossings`]), which the `slab`
+    /// model keeps analytic.
     pub fn first_t(&self, m: usize) -> (&DMatrix<f64>, &DMatrix<f64>) {
         match self.walk_free_t.get(m) {
             Some((down, up)) => (down, up),

@@ -72,6 +72,18 @@ fn cases() -> Vec<(&'static str, PaperParams)> {
                 FaceScattering::Single,
             ),
         ),
+        // Unequal faces smoother than the grid on a thin sheet: the
+        // unscattered transmission's narrow lobe and its own sampling lobe.
+        (
+            "thin-narrow",
+            sheet(
+                0.02,
+                0.5,
+                30.0,
+                [(1.5, 0.05, Ggx), (1.5, 0.02, Beckmann)],
+                FaceScattering::Multiple,
+            ),
+        ),
     ];
     v.push((
         "smooth",
@@ -187,7 +199,12 @@ fn sample_returns_eval_and_pdf() {
 }
 
 /// 400 draws of `b.sample` at `wo`: each draw's `f` and `pdf` against
-/// `eval` and `pdf` at its `wi`, to 1e-12 (rounding).
+/// `eval` and `pdf` at its `wi`, to 1e-12 (rounding); the pdf to 1e-11:
+/// `pdf` places `wi` in the table's cells by the azimuth difference from
+/// its cosine (`acos`, which loses digits where that difference is small),
+/// the sampler by its own draw, and where a thin sheet with narrow faces
+/// sends the light straight through (`thin-narrow`) the density changes
+/// fast across the cell: 1.2e-12 measured there.
 fn sample_agrees(name: &str, b: &SlabBsdf, wo: DVec3) {
     for i in 0..400 {
         let u = [
@@ -210,7 +227,7 @@ fn sample_agrees(name: &str, b: &SlabBsdf, wo: DVec3) {
             );
         }
         assert!(
-            (s.pdf - pdf).abs() <= 1e-12 * pdf,
+            (s.pdf - pdf).abs() <= 1e-11 * pdf,
             "{name} at wo {wo:?}, wi {:?}: pdf {} vs {pdf}",
             s.wi,
             s.pdf
