@@ -34,6 +34,22 @@ pub enum SlabError {
         /// Which step failed.
         step: &'static str,
     },
+    /// A rough face whose projection on the grid cannot be scaled to the
+    /// face's own albedo (known for faces close to index-matched: `eta`
+    /// between 1 and about 1.1).
+    #[error(
+        "the model `slab` cannot represent the rough face of index {eta} ({dist}, m = {m}): its projection on the grid \
+         did not converge to the face's albedo; `slab` does not support faces this close to index-matched yet \
+         (eta between 1 and about 1.1, more nodes do not help); the model `paper` does"
+    )]
+    UnresolvedFace {
+        /// The face's relative index.
+        eta: f64,
+        /// Its roughness.
+        m: f64,
+        /// Its microfacet distribution's name.
+        dist: &'static str,
+    },
     /// A configuration the solver does not handle yet.
     #[error("not supported yet: {0}")]
     Unsupported(&'static str),

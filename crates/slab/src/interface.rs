@@ -761,7 +761,7 @@ fn normalise_face(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut [
                     continue;
                 }
                 if !(*a > 0.0 && a.is_finite()) {
-                    return Err(unresolved());
+                    return Err(unresolved(bd));
                 }
                 worst = worst.max((a / t.max(nil) - 1.0).abs());
                 *s *= (t.max(nil) / a).sqrt();
@@ -777,7 +777,7 @@ fn normalise_face(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut [
         }
     }
     if !converged {
-        return Err(unresolved());
+        return Err(unresolved(bd));
     }
     for layer in l.iter_mut() {
         scale_rows_cols(&mut layer.r_top, &s_out, &s_out);
@@ -797,12 +797,16 @@ pub(crate) fn scale_rows_cols(k: &mut DMatrix<f64>, rows: &[f64], cols: &[f64]) 
     }
 }
 
-/// The error of a face whose lobes the grid does not resolve at all.
-fn unresolved() -> SlabError {
-    SlabError::Discretisation {
-        name: "nodes",
-        value: f64::NAN,
-        range: "enough nodes to resolve the rough face's lobes (the normalisation to core's albedo did not converge)",
+/// The error of a face whose projection [`normalise_face`] cannot scale to
+/// its albedo: every face with `1 < eta <= 1.1` but a few (eta 1.1 with
+/// `m` of 0.5 and more), whatever the nodes (128 do not help eta 1.05): the
+/// square-root iteration starts 3.6e5 off at one node and is still 5e-5
+/// off after [`MAX_NORMALISATION_ITERATIONS`] (measured 2026-12-06).
+fn unresolved(bd: &RoughDielectric) -> SlabError {
+    SlabError::UnresolvedFace {
+        eta: bd.eta,
+        m: bd.m,
+        dist: bd.dist.name(),
     }
 }
 
