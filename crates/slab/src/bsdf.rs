@@ -2115,26 +2115,30 @@ impl SlabBsdf {
         // table. Not where `exp(-tau)` is below UNSCATTERED_FLOOR (nothing
         // comes through; the projection is as small).
         let two_rough = !paper.face_is_smooth(Side::Front) && !paper.face_is_smooth(Side::Back);
+        let tau_of = |k: usize| specs[solution_of.iter().position(|&x| x == k).unwrap_or(0)].medium.tau;
+        // The distinct optical thicknesses that get the term (media that
+        // differ only in their albedo share it), all tabulated in one pass.
+        let mut taus: Vec<f64> = Vec::new();
+        if prepared.coating.is_none() && two_rough {
+            for k in 0..solutions.len() {
+                let tau = tau_of(k);
+                if (-tau).exp() > UNSCATTERED_FLOOR && !taus.contains(&tau) {
+                    taus.push(tau);
+                }
+            }
+        }
+        let terms: Vec<TwoCrossings> = if taus.is_empty() {
+            Vec::new()
+        } else {
+            let (front, _) = specs[0].front.dielectric("_f")?;
+            let (back, _) = specs[0].back.dielectric("_b")?;
+            TwoCrossings::unscattered_each(front, back, &taus).unwrap_or_default()
+        };
         let mut unscattered: Vec<Option<TwoCrossings>> = Vec::new();
         let mut unscattered_proj: Vec<[Vec<DMatrix<f64>>; 2]> = Vec::new();
         for (k, (_, unsc)) in solutions.iter().enumerate() {
-            let c = solution_of.iter().position(|&x| x == k).unwrap_or(0);
-            let tau = specs[c].medium.tau;
-            // Media that differ only in their albedo share the term.
-            let same_tau = unscattered
-                .iter()
-                .flatten()
-                .find(|t: &&TwoCrossings| t.between() == Between::Straight { tau })
-                .cloned();
-            let term = if same_tau.is_some() {
-                same_tau
-            } else if prepared.coating.is_none() && two_rough && (-tau).exp() > UNSCATTERED_FLOOR {
-                let (front, _) = specs[0].front.dielectric("_f")?;
-                let (back, _) = specs[0].back.dielectric("_b")?;
-                TwoCrossings::unscattered(front, back, tau)
-            } else {
-                None
-            };
+            let tau = tau_of(k);
+            let term = terms.iter().find(|t| t.between() == Between::Straight { tau }).cloned();
             let proj = match term {
                 Some(_) => {
                     let [f, b] = &prepared.faces;

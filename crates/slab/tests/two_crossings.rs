@@ -461,3 +461,28 @@ fn thin_sheet_converges_near_the_normal() {
         .flat_map(|ti| [-15.0, -9.0, -6.5, -3.0, 0.0, 2.5, 6.5, 10.0, 15.0].map(|to| (ti, to)));
     largest_change_with_twice_the_nodes(&p, pairs, true, 2.5e-2);
 }
+
+/// A coloured sheet's channels share one pass over the table's entries
+/// (`TwoCrossings::unscattered_each`): each of its tables is the one built
+/// for that optical thickness alone, to rounding (1e-12 of the value), for
+/// unequal faces.
+#[test]
+fn channels_share_one_pass() {
+    let front = RoughDielectric::new(Distribution::Ggx, 1.5, 0.3).unwrap();
+    let back = RoughDielectric::new(Distribution::Beckmann, 1.5, 0.05).unwrap();
+    let taus = [0.3, 1.2, 2.5];
+    let each = TwoCrossings::unscattered_each(front, back, &taus).unwrap();
+    assert_eq!(each.len(), taus.len());
+    for (t, &tau) in each.iter().zip(&taus) {
+        assert_eq!(t.between(), Between::Straight { tau });
+        let alone = TwoCrossings::unscattered(front, back, tau).unwrap();
+        for (ti, to, po) in POINTS {
+            let (wi, wo) = (dir(ti, 180.0), dir(to, po));
+            let (a, b) = (t.eval(wi, wo), alone.eval(wi, wo));
+            assert!(
+                (a - b).abs() <= 1e-12 * b.abs().max(1e-300),
+                "tau {tau} at {ti} -> ({to}, {po}): {a:e} in the shared pass, {b:e} alone"
+            );
+        }
+    }
+}
