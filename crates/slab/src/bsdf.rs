@@ -44,8 +44,9 @@
 //!   subtracted from the table, the term balanced to it at and between the
 //!   nodes, and what the term still misses at a node given to the table's
 //!   balance (module doc of [`crate::two_crossings`], "Energy"). Not where
-//!   `exp(-tau)` is below [`UNSCATTERED_FLOOR`]. Sampled with the table:
-//!   its cells' densities include it;
+//!   `exp(-tau)` is below [`UNSCATTERED_FLOOR`]. Sampled by a lobe of its
+//!   own and with the table, whose cells' densities include it ("Sampling"
+//!   below);
 //! - for two smooth faces, the unscattered light: mirror-like internal
 //!   reflections and straight-through transmission are delta lobes, in
 //!   closed form (equal indices: `T = (1-F)^2 a / (1 - F^2 a^2)`, internal
@@ -2258,46 +2259,38 @@ impl SlabBsdf {
         };
         let shape_of = |side: Side| move |m: f64| crossing_shape_at(&g.mu, |x| face_r_at(side, x), m);
         let (shape_front, shape_back) = (shape_of(Side::Front), shape_of(Side::Back));
-        let mut coat_front = coat_front;
-        if let (Some(c), Some(p0)) = (coat_front.as_mut(), coat_proj.first()) {
-            let target = albedo0(p0, 0, 0);
-            c.balance(&g.mu, &target, &target, None);
-        }
-        for (term, proj) in unscattered.iter_mut().zip(&unscattered_proj) {
-            if let (Some(t), Some(pf), Some(pb)) = (term.as_mut(), proj[0].first(), proj[1].first()) {
-                let (t1, t2) = (albedo0(pf, 0, 1), albedo0(pb, 1, 0));
-                t.balance(&g.mu, &t1, &t2, Some([&shape_front, &shape_back]));
-            }
-        }
         // Per [reflection, transmission][side][node] and channel: what the
         // table's balance targets besides its own quadrature albedo, the
         // projections' albedo as the table lost it (`s(j) sum_o w_o mu_o
         // P[o][j] / (w_j mu_j)`, the exit's crossing factor divided out as
-        // in the table's targets) less the analytic terms' albedo at the
-        // node by their own rule.
+        // in the table's targets) less the albedo the analytic terms'
+        // balance reached at the node (by their own rule).
         let mut adjust: [[Vec<Rgb>; 2]; 2] = std::array::from_fn(|_| std::array::from_fn(|_| vec![Rgb::ZERO; n]));
         let lost = |p0: &DMatrix<f64>, lit: usize, j: usize| cross[lit][j] * column_albedo(p0, g, g, j);
-        if let (Some(c), Some(p0)) = (coat_front.as_ref(), coat_proj.first()) {
-            for (j, (a, &m)) in adjust[0][0].iter_mut().zip(&g.mu).enumerate() {
-                *a = Rgb::splat(lost(p0, 0, j) - c.albedo_of(m, |a, b| c.eval(a, b)));
+        let mut coat_front = coat_front;
+        if let (Some(c), Some(p0)) = (coat_front.as_mut(), coat_proj.first()) {
+            let target = albedo0(p0, 0, 0);
+            let [reached, _] = c.balance(&g.mu, &target, &target, None);
+            for (j, (a, have)) in adjust[0][0].iter_mut().zip(reached).enumerate() {
+                *a = Rgb::splat(lost(p0, 0, j) - have);
             }
         }
-        for (k, (term, proj)) in unscattered.iter().zip(&unscattered_proj).enumerate() {
-            if let (Some(t), Some(pf), Some(pb)) = (term.as_ref(), proj[0].first(), proj[1].first()) {
-                let per_node: Vec<[f64; 2]> =
-                    g.mu.par_iter()
-                        .enumerate()
-                        .map(|(j, &m)| {
-                            [
-                                lost(pf, 0, j) - t.albedo_of(m, |a, b| t.eval(a, b)),
-                                lost(pb, 1, j) - t.albedo_of(m, |a, b| t.eval(b, a)),
-                            ]
-                        })
-                        .collect();
-                for (c, _) in solution_of.iter().enumerate().filter(|(_, &x)| x == k) {
-                    for (j, d) in per_node.iter().enumerate() {
-                        adjust[1][0][j].0[c] = d[0];
-                        adjust[1][1][j].0[c] = d[1];
+        // Per side and node: the unscattered terms' albedo reached, the
+        // channels' mean (the weight of their sampling lobe).
+        let mut unscattered_albedo: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
+        for (k, (term, proj)) in unscattered.iter_mut().zip(&unscattered_proj).enumerate() {
+            if let (Some(t), Some(pf), Some(pb)) = (term.as_mut(), proj[0].first(), proj[1].first()) {
+                let (t1, t2) = (albedo0(pf, 0, 1), albedo0(pb, 1, 0));
+                let reached = t.balance(&g.mu, &t1, &t2, Some([&shape_front, &shape_back]));
+                for (side, (p0, reached)) in [pf, pb].into_iter().zip(reached).enumerate() {
+                    let channels = solution_of.iter().filter(|&&x| x == k).count() as f64 / 3.0;
+                    let mean = &mut unscattered_albedo[side];
+                    mean.resize(n, 0.0);
+                    for (j, have) in reached.into_iter().enumerate() {
+                        mean[j] += channels * have;
+                        for (c, _) in solution_of.iter().enumerate().filter(|(_, &x)| x == k) {
+                            adjust[1][side][j].0[c] = lost(p0, side, j) - have;
+                        }
                     }
                 }
             }
@@ -2525,6 +2518,13 @@ impl SlabBsdf {
         if front_smooth || back_smooth {
             flags |= BsdfFlags::SPECULAR;
         }
+        // The unscattered term's sampling lobe, as wide as the term's lobe
+        // in half-vector slope.
+        let unscattered_lobe = unscattered
+            .iter()
+            .flatten()
+            .next()
+            .map(|t| Microfacet::new(Distribution::Ggx, UNSCATTERED_LOBE_SCALE * t.lobe_width().max(1e-4)));
         let mut me = SlabBsdf {
             paper,
             mu: g.mu.clone(),
@@ -2545,35 +2545,9 @@ impl SlabBsdf {
             coat: coat_front,
             unscattered,
             solution_of,
-            unscattered_albedo: [Vec::new(), Vec::new()],
-            unscattered_lobe: None,
+            unscattered_albedo,
+            unscattered_lobe,
         };
-        if me.unscattered.iter().any(Option::is_some) {
-            // The lobe's width in half-vector slope: the two faces' turns of
-            // the direction, `(eta - 1) m / sqrt 2` each (two_crossings'
-            // module doc), added in quadrature.
-            let width = |side: Side| -> f64 {
-                let f = &specs[0];
-                let (eta, m) = match side {
-                    Side::Front => (f.front.eta(), p.m_f),
-                    Side::Back => (f.back.eta(), p.m_b),
-                };
-                (eta - 1.0) * m * std::f64::consts::FRAC_1_SQRT_2
-            };
-            let alpha = width(Side::Front).hypot(width(Side::Back)).max(1e-4);
-            me.unscattered_lobe = Some(Microfacet::new(Distribution::Ggx, UNSCATTERED_LOBE_SCALE * alpha));
-            for side in Side::BOTH {
-                let z = if side == Side::Front { 1.0 } else { -1.0 };
-                me.unscattered_albedo[side as usize] = me
-                    .mu
-                    .par_iter()
-                    .map(|&m| {
-                        let wi = DVec3::new((1.0 - m * m).max(0.0).sqrt(), 0.0, z * m);
-                        me.analytic_albedo(wi).1.mean()
-                    })
-                    .collect();
-            }
-        }
         for side in Side::BOTH {
             let (cells, albedo): (Vec<CellDensity>, Vec<f64>) =
                 (0..n).into_par_iter().map(|j| me.cell_density(side, me.mu[j])).unzip();
@@ -2993,10 +2967,16 @@ impl SlabBsdf {
                 t.eval(wo, flip(wi))
             }
         };
+        self.unscattered_per_channel(at)
+    }
+
+    /// `value` of each channel's unscattered term (0 where it has none).
+    #[inline]
+    fn unscattered_per_channel(&self, value: impl Fn(&TwoCrossings) -> f64) -> Rgb {
         // At most one term per channel (no allocation in `eval`).
         let mut v = [0.0; 3];
         for (v, t) in v.iter_mut().zip(&self.unscattered) {
-            *v = t.as_ref().map_or(0.0, at);
+            *v = t.as_ref().map_or(0.0, &value);
         }
         Rgb(self.solution_of.map(|k| v[k]))
     }
@@ -3028,20 +3008,14 @@ impl SlabBsdf {
             (Some(c), true) => c.albedo_of(mu, |a, b| c.eval(a, b)),
             _ => 0.0,
         };
-        let t: Vec<f64> = self
-            .unscattered
-            .iter()
-            .map(|t| {
-                t.as_ref().map_or(0.0, |t| {
-                    if wi.z > 0.0 {
-                        t.albedo_of(mu, |a, b| t.eval(a, b))
-                    } else {
-                        t.albedo_of(mu, |a, b| t.eval(b, a))
-                    }
-                })
-            })
-            .collect();
-        (Rgb::splat(r), Rgb(self.solution_of.map(|k| t[k])))
+        let t = self.unscattered_per_channel(|t| {
+            if wi.z > 0.0 {
+                t.albedo_of(mu, |a, b| t.eval(a, b))
+            } else {
+                t.albedo_of(mu, |a, b| t.eval(b, a))
+            }
+        });
+        (Rgb::splat(r), t)
     }
 
     /// The continuous part of `f` (the table, clamped at 0, plus the analytic surface reflection).

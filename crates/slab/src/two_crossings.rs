@@ -250,8 +250,7 @@ impl TwoCrossings {
         // the end of the axis, where its points thin out (the narrowest
         // lobe's energy through the table: 2.6% low at 60 degrees with
         // `sigma` itself, 1.6% with twice it).
-        let width = |f: &RoughDielectric| (f.eta - 1.0) * f.m * std::f64::consts::FRAC_1_SQRT_2;
-        let sigma = 2.0 * width(&front).max(width(&second)).max(1e-4);
+        let sigma = 2.0 * face_width(&front).max(face_width(&second)).max(1e-4);
         let np = if folded { TABLE_SIZE[2] } else { 2 * TABLE_SIZE[2] - 1 };
         let me = TwoCrossings {
             front,
@@ -312,6 +311,12 @@ impl TwoCrossings {
     /// What is between the crossings.
     pub fn between(&self) -> Between {
         self.between
+    }
+
+    /// The lobe's width in half-vector slope: the two crossings' turns of
+    /// the direction, `(eta - 1) m / sqrt 2` each, added in quadrature.
+    pub fn lobe_width(&self) -> f64 {
+        face_width(&self.front).hypot(face_width(&self.second))
     }
 
     /// The pair of directions at table coordinates `(x, cos theta_d, cos^2
@@ -435,8 +440,11 @@ impl TwoCrossings {
     /// same flux; where they do not (the projection's quadrature against
     /// the table's rule, about 1e-5 of it), the iteration stops once only
     /// the factors' common scale moves, and the caller takes up what the
-    /// albedo misses (the model `slab` gives it to its table).
-    pub fn balance(&mut self, mu: &[f64], first: &[f64], second: &[f64], shapes: Option<Shapes>) {
+    /// albedo misses (the model `slab` gives it to its table). Returns the
+    /// albedo reached at each cosine of `mu`, for light at the first face
+    /// and at the second (by the rule of `albedo_of`: equal to it to
+    /// rounding, as `A` and `B` are).
+    pub fn balance(&mut self, mu: &[f64], first: &[f64], second: &[f64], shapes: Option<Shapes>) -> [Vec<f64>; 2] {
         let n = mu.len();
         self.scale_mu = mu.to_vec();
         let points = STEPS * n + 1;
@@ -516,22 +524,14 @@ impl TwoCrossings {
             change
         };
         let a = hats(false);
+        let b = (!self.folded).then(|| hats(true));
         let (mut r1, mut r2) = (vec![1.0; m], vec![1.0; m]);
-        if self.folded {
-            for _ in 0..BALANCE_ITERATIONS {
-                let k = times(&a, &r1);
-                if update(&mut r1, &k, &targets[0], true) < 1e-12 {
-                    break;
-                }
-            }
-            r2.clone_from(&r1);
-        } else {
-            let b = hats(true);
+        if let Some(b) = &b {
             let mut last = f64::INFINITY;
             for _ in 0..BALANCE_ITERATIONS {
                 let k = times(&a, &r2);
                 let c1 = update(&mut r1, &k, &targets[0], false);
-                let k = times(&b, &r1);
+                let k = times(b, &r1);
                 let c2 = update(&mut r2, &k, &targets[1], false);
                 let change = c1.max(c2);
                 // Converged, or only the two factors' common scale still
@@ -541,7 +541,29 @@ impl TwoCrossings {
                 }
                 last = change;
             }
+        } else {
+            for _ in 0..BALANCE_ITERATIONS {
+                let k = times(&a, &r1);
+                if update(&mut r1, &k, &targets[0], true) < 1e-12 {
+                    break;
+                }
+            }
+            r2.clone_from(&r1);
         }
+        // The albedo reached at the cosines (a symmetric term's the same
+        // both ways), before the factors go to their points.
+        let node = |j: usize| if shapes.is_some() { STEPS * (j + 1) } else { j };
+        let reached_first: Vec<f64> = {
+            let k = times(&a, &r2);
+            (0..n).map(|j| r1[node(j)] * k[node(j)]).collect()
+        };
+        let reached_second = match &b {
+            Some(b) => {
+                let k = times(b, &r1);
+                (0..n).map(|j| r2[node(j)] * k[node(j)]).collect()
+            }
+            None => reached_first.clone(),
+        };
         let values = match shapes {
             Some(_) => [r1, r2],
             None => [r1, r2].map(|r| (0..points).map(|p| lerp(&r, p)).collect()),
@@ -565,6 +587,7 @@ impl TwoCrossings {
             })
             .collect();
         self.points_mu = fine;
+        [reached_first, reached_second]
     }
 
     /// `int f(wi, wo) mu_o dwo` for `wi` at cosine `mu` (azimuth 0) over
@@ -780,4 +803,11 @@ fn visible_normals(mf: &Microfacet, w: DVec3, u: &[f64]) -> Vec<DVec3> {
             .flat_map(|&a| u.iter().map(move |&b| mf.sample_visible(w, [a, b])))
             .collect(),
     }
+}
+
+/// How far a rough face turns a direction it refracts, in half-vector
+/// slope: `(eta - 1) m / sqrt 2`, about 1.4 times the standard deviation
+/// of the lobe it makes (module doc, "Evaluation").
+fn face_width(f: &RoughDielectric) -> f64 {
+    (f.eta - 1.0) * f.m * std::f64::consts::FRAC_1_SQRT_2
 }
