@@ -209,7 +209,7 @@ pub const COSINE_SHARE: f64 = 0.1;
 
 /// Most Fourier orders a [`SlabBsdf`] solves or evaluates ([`SlabOptions::orders`],
 /// [`SlabOptions::walk_orders`]).
-pub const MAX_ORDERS: usize = 512;
+pub const MAX_ORDERS: usize = 2048;
 
 /// How finely a [`SlabBsdf`] is solved and tabulated.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -226,7 +226,11 @@ pub struct SlabOptions {
     pub orders: usize,
     /// Fourier orders of the light the lit face's microsurface reflects
     /// more than once (`face_scattering = "multiple"`), `orders` to
-    /// [`MAX_ORDERS`]; default 256. At grazing incidence on a smooth face
+    /// [`MAX_ORDERS`]; default 256, for a face of roughness 0.15 or more: a
+    /// smoother face takes more, in proportion to `1 / alpha` and at most
+    /// 2.5 times ([`crate::interface::walk_orders_for`]; devB's Beckmann
+    /// 0.08 front 512, which moved its reflection at 80 R -80 by 2.8% when
+    /// it had 256; builds 0.75 -> 0.86 s). At grazing incidence on a smooth face
     /// this light is a forward peak narrower in azimuth than `orders`
     /// resolve (luster's Beckmann 0.15 front lit at 75 degrees, seen at 80:
     /// 6.2% under its converged value with 48 orders, Fejer-summed; now
@@ -240,10 +244,9 @@ pub struct SlabOptions {
     /// inside the build while writing it; examples/walk_orders.rs gives the
     /// whole build against `walk_orders`). `eval` reads the orders past
     /// `orders` from samples of their sum in azimuth (module `bsdf`, `SeriesSamples`), so
-    /// its time does not grow with `walk_orders`; 512 (which resolves devB's
-    /// Beckmann 0.08 front, README "Convergence") costs devB 0.17 s more
-    /// build (0.76-0.81 s against 0.59-0.70 s on 2026-12-05, a probe timing
-    /// builds, not kept) and 1.6 MB more memory.
+    /// its time does not grow with `walk_orders`; the build's does (the
+    /// samples and the check for ringing by discrete cosine transforms
+    /// since 2026-12-06, `cosine_sums`).
     pub walk_orders: usize,
     /// Bins in `|phi|` of the sampling density, 1 to 1024.
     pub phi_bins: usize,
@@ -647,22 +650,17 @@ struct SeriesSamples<'a> {
 impl SeriesSamples<'_> {
     /// The samples of `sum_m a[m] cos((first + m) phi)` (layout of
     /// [`SeriesSamples`], `N =` [`SAMPLES_PER_ORDER`]` (first + a.len())`):
-    /// the Chebyshev recurrence over the orders, at all azimuths at once.
+    /// a discrete cosine transform of type I on `[0, pi]` ([`cosine_sums`]),
+    /// the ghosts mirrored (the sum is even about 0 and about `pi`).
     fn sum(a: &[f64], first: usize) -> Vec<f32> {
         let n = SAMPLES_PER_ORDER * (first + a.len());
-        let phi: Vec<f64> = (0..n + GHOSTS).map(|k| PI * (k as f64 - 2.0) / n as f64).collect();
-        let two_c: Vec<f64> = phi.iter().map(|p| 2.0 * p.cos()).collect();
-        let mut prev: Vec<f64> = phi.iter().map(|p| (first as f64 - 1.0) * p).map(f64::cos).collect();
-        let mut cur: Vec<f64> = phi.iter().map(|p| (first as f64 * p).cos()).collect();
-        let mut out = vec![0.0; n + GHOSTS];
-        for &x in a {
-            for k in 0..n + GHOSTS {
-                out[k] += x * cur[k];
-                let next = two_c[k] * cur[k] - prev[k];
-                prev[k] = cur[k];
-                cur[k] = next;
-            }
-        }
+        let mut c = vec![0.0; n + 1];
+        c[first..first + a.len()].copy_from_slice(a);
+        let at = cosine_sums(&c, Samples::Ends);
+        let mut out = Vec::with_capacity(n + GHOSTS);
+        out.extend([at[2], at[1]]);
+        out.extend_from_slice(&at);
+        out.extend([at[n - 1], at[n - 2]]);
         out.into_iter().map(|x| x as f32).collect()
     }
 
@@ -1458,24 +1456,53 @@ fn negative_mass(v: &[Rgb], k: usize) -> f64 {
     // Trailing zero orders (pairs the walk's high orders do not reach) cost nothing.
     let v = &v[..v.iter().rposition(|x| x.0[k] != 0.0).map_or(1, |i| i + 1)];
     let points = 2 * v.len();
-    // The Chebyshev recurrence at all points at once (independent, so the
-    // loop over points vectorises).
-    let c: Vec<f64> = (0..points)
-        .map(|i| (PI * (i as f64 + 0.5) / points as f64).cos())
-        .collect();
-    let mut prev = c.clone();
-    let mut cur = vec![1.0; points];
-    let mut f = vec![0.0; points];
-    for x in v {
-        let a = x.0[k];
-        for i in 0..points {
-            f[i] += a * cur[i];
-            let next = 2.0 * c[i] * cur[i] - prev[i];
-            prev[i] = cur[i];
-            cur[i] = next;
+    let mut c = vec![0.0; points];
+    for (ci, x) in c.iter_mut().zip(v) {
+        *ci = x.0[k];
+    }
+    let f = cosine_sums(&c, Samples::Midpoints);
+    f.iter().map(|&x| (-x).max(0.0)).sum::<f64>() / points as f64
+}
+
+/// Where [`cosine_sums`] sums a cosine series on `[0, pi]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Samples {
+    /// At `phi_k = k pi / (L - 1)`, `k = 0..L`, both ends included.
+    Ends,
+    /// At the midpoints `phi_k = (k + 1/2) pi / L`, `k = 0..L`.
+    Midpoints,
+}
+
+/// `sum_m c[m] cos(m phi_k)` for `m` and `k` in `0..L` (`L = c.len()`) at
+/// the azimuths `at` says, by a discrete cosine transform (`rustdct`: type I
+/// for the ends, type III for the midpoints; `O(L log L)`, where the
+/// Chebyshev recurrence at every point was `O(L^2)` and took a quarter of the
+/// build of a sheet whose walk has 960 orders, glossy's). The plans are
+/// kept per thread and length.
+fn cosine_sums(c: &[f64], at: Samples) -> Vec<f64> {
+    use rustdct::DctPlanner;
+    use std::cell::RefCell;
+    thread_local! {
+        static PLANNER: RefCell<DctPlanner<f64>> = RefCell::new(DctPlanner::new());
+    }
+    let l = c.len();
+    let mut buf = c.to_vec();
+    // rustdct's transforms are unnormalised, with the first (type I: and
+    // last) coefficient halved.
+    buf[0] *= 2.0;
+    match at {
+        Samples::Ends => {
+            if l < 2 {
+                return buf.iter().map(|x| 0.5 * x).collect();
+            }
+            buf[l - 1] *= 2.0;
+            PLANNER.with(|p| p.borrow_mut().plan_dct1(l)).process_dct1(&mut buf);
+        }
+        Samples::Midpoints => {
+            PLANNER.with(|p| p.borrow_mut().plan_dct3(l)).process_dct3(&mut buf);
         }
     }
-    f.iter().map(|&x| (-x).max(0.0)).sum::<f64>() / points as f64
+    buf
 }
 
 /// How much more of a node pair's mean (order 0 of its reflection) the
@@ -2008,14 +2035,14 @@ impl SlabBsdf {
             return Err(SlabError::Discretisation {
                 name: "orders",
                 value: opts.orders as f64,
-                range: "[1, 512]",
+                range: "[1, 2048]",
             });
         }
         if opts.walk_orders < opts.orders || opts.walk_orders > MAX_ORDERS {
             return Err(SlabError::Discretisation {
                 name: "walk_orders",
                 value: opts.walk_orders as f64,
-                range: "[orders, 512]",
+                range: "[orders, 2048]",
             });
         }
         for (name, v) in [("phi_bins", opts.phi_bins), ("mu_bins", opts.mu_bins)] {
@@ -2071,7 +2098,7 @@ impl SlabBsdf {
         let m_solved = opts.orders;
         // The walk's reflection to its orders is flat to half of them
         // (`interface::walk_window`; 0 would be Fejer's weights).
-        let flat = opts.walk_orders / 2;
+        // Each face's own orders (`walk_orders_for` its roughness).
         let m_count = prepared
             .faces
             .iter()
@@ -2307,6 +2334,10 @@ impl SlabBsdf {
         for side in 0..2 {
             // The lit face's walk reflection beyond Fejer's sum (module doc).
             let walk_r = &prepared.faces[side].walk_r_top;
+            // This face's walk orders (`interface::walk_orders_for`) and
+            // its window's flat part, half of them.
+            let count = walk_r.len().max(m_solved);
+            let flat = count / 2;
             // The table's factor of pair (o, j)'s orders m >= 1 in reflection.
             let scale_r = |o: usize, j: usize| 2.0 / (2.0 * PI * g.w[j] * g.mu[j]) * cross[side][j] * cross[side][o];
             for (t, transmit) in [false, true].into_iter().enumerate() {
@@ -2324,7 +2355,7 @@ impl SlabBsdf {
                                 let scale = eps / (2.0 * PI * g.w[j] * g.mu[j]) * cross[side][j] * cross[exit][o];
                                 let gain = walk.map_or(0.0, |w| {
                                     // The solution carries the walk with Fejer's weights to its orders (crate::interface).
-                                    w[(o, j)] * (walk_window(m, m_count, flat) - walk_window(m, m_solved, 0))
+                                    w[(o, j)] * (walk_window(m, count, flat) - walk_window(m, m_solved, 0))
                                 });
                                 let (vt, vd) = if both_smooth {
                                     (kf[(o, j)] - ku[(o, j)], 0.0)
@@ -2358,7 +2389,7 @@ impl SlabBsdf {
             if extra_len == 0 {
                 continue;
             }
-            if walk_r.len() < m_count {
+            if walk_r.len() <= m_solved {
                 // This face has no walk reflection past the solution's orders
                 // (a smooth face, Walter's face alone, or a walk the grid does
                 // not resolve) while the other face has.
@@ -2371,10 +2402,10 @@ impl SlabBsdf {
                     let pole = o == n - 1 || j == n - 1;
                     (m_solved..m_count).map(move |m| {
                         let w = walk_r.get(m).map_or(0.0, |w| w[(o, j)]);
-                        if pole {
+                        if pole || m >= count {
                             Rgb::ZERO
                         } else {
-                            Rgb::splat(w * walk_window(m, m_count, flat) * scale_r(o, j))
+                            Rgb::splat(w * walk_window(m, count, flat) * scale_r(o, j))
                         }
                     })
                 })
@@ -2389,10 +2420,10 @@ impl SlabBsdf {
             let ks = if grey { 1 } else { 3 };
             // What pair (o, j)'s order m gains when Fejer's weights replace the flat window.
             let to_fejer = |o: usize, j: usize, m: usize| -> f64 {
-                if m == 0 || o == n - 1 || j == n - 1 {
+                if m == 0 || m >= count || o == n - 1 || j == n - 1 {
                     return 0.0;
                 }
-                walk_r[m][(o, j)] * (walk_window(m, m_count, 0) - walk_window(m, m_count, flat)) * scale_r(o, j)
+                walk_r[m][(o, j)] * (walk_window(m, count, 0) - walk_window(m, count, flat)) * scale_r(o, j)
             };
             let rings = |o: usize, j: usize| -> bool {
                 let p = o * n + j;
@@ -2664,6 +2695,21 @@ impl SlabBsdf {
         } else {
             Rgb([acc.0[0] * g(0), acc.0[1] * g(1), acc.0[2] * g(2)])
         }
+    }
+
+    /// The most Fourier orders any node pair of the table keeps (the lit
+    /// faces' walk at grazing pairs: [`SlabOptions::walk_orders`], more for
+    /// a face smoother than 0.15, `interface::walk_orders_for`): a rule in
+    /// azimuth that integrates `eval` exactly needs more points than this.
+    pub fn most_orders(&self) -> usize {
+        self.table
+            .len
+            .iter()
+            .flatten()
+            .flat_map(|v| v.iter())
+            .map(|&l| usize::from(l))
+            .max()
+            .unwrap_or(0)
     }
 
     /// The factors by which the table's light crossing the face on `side`
@@ -3174,8 +3220,9 @@ impl ComponentModel for SlabBsdf {
 #[cfg(test)]
 mod tests {
     use super::{
-        cos_series, dot_orders, fourier_sum, fourier_sum_pole, fourier_sum_with, locate, ridge_ratios, shape_at,
-        triangle_weights, CellDensity, PoleCorners, SeriesSamples, Tables, MAX_ORDERS, SAMPLES_PER_ORDER, SHAPE_STEPS,
+        cos_series, cosine_sums, dot_orders, fourier_sum, fourier_sum_pole, fourier_sum_with, locate, negative_mass,
+        ridge_ratios, shape_at, triangle_weights, CellDensity, PoleCorners, Samples, SeriesSamples, Tables, MAX_ORDERS,
+        SAMPLES_PER_ORDER, SHAPE_STEPS,
     };
     use paperbsdf_core::Rgb;
     use std::f64::consts::PI;
@@ -3358,6 +3405,66 @@ mod tests {
                 );
             }
             eprintln!("series {first}..{len}: largest error {worst:.2e}, bound {bound:.2e}, sum |c_m| {scale:.1}");
+        }
+    }
+
+    /// The discrete cosine transforms are the cosine sums they replace, at
+    /// both kinds of points, for lengths from 1 to beyond the most orders
+    /// (odd, even, prime), to 1e-12 of the coefficients' sum (the direct
+    /// sums' own rounding of `cos(m phi)` reaches 1.4e-13 of it at 4097).
+    #[test]
+    fn cosine_sums_are_the_sums() {
+        for l in [1usize, 2, 3, 5, 16, 97, 256, 1031, 4097] {
+            let c: Vec<f64> = (0..l).map(|m| ((m * 7919) % 101) as f64 / 101.0 - 0.4).collect();
+            let scale: f64 = c.iter().map(|x| x.abs()).sum();
+            for at in [Samples::Ends, Samples::Midpoints] {
+                let got = cosine_sums(&c, at);
+                assert_eq!(got.len(), l);
+                for (k, g) in got.iter().enumerate() {
+                    let phi = match at {
+                        Samples::Ends if l == 1 => 0.0,
+                        Samples::Ends => PI * k as f64 / (l - 1) as f64,
+                        Samples::Midpoints => PI * (k as f64 + 0.5) / l as f64,
+                    };
+                    let want: f64 = c.iter().enumerate().map(|(m, x)| x * (m as f64 * phi).cos()).sum();
+                    assert!(
+                        (g - want).abs() <= 1e-12 * scale,
+                        "{at:?} L {l} k {k}: {g} against {want}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// [`negative_mass`] is the midpoint rule's mean of the series' negative
+    /// part, summed directly.
+    #[test]
+    fn negative_mass_is_the_midpoint_rule() {
+        for l in [2usize, 7, 48, 300] {
+            let v: Vec<Rgb> = (0..l)
+                .map(|m| {
+                    Rgb::splat(if m == 0 {
+                        0.3
+                    } else {
+                        ((m * 31) % 17) as f64 / 17.0 - 0.45
+                    })
+                })
+                .collect();
+            let points = 2 * l;
+            let direct: f64 = (0..points)
+                .map(|i| {
+                    let phi = PI * (i as f64 + 0.5) / points as f64;
+                    let f: f64 = v.iter().enumerate().map(|(m, x)| x.0[0] * (m as f64 * phi).cos()).sum();
+                    (-f).max(0.0)
+                })
+                .sum::<f64>()
+                / points as f64;
+            let got = negative_mass(&v, 0);
+            assert!(direct > 0.0, "L {l}: the test series must ring");
+            assert!(
+                (got - direct).abs() <= 1e-13 * l as f64,
+                "L {l}: {got} against {direct}"
+            );
         }
     }
 

@@ -147,7 +147,8 @@
 //! [`crate::face_walk::outside_reflection`]; luster's orders 48 to 96 from
 //! it are within 8e-6 of the full chain's). The `slab` model sums it to
 //! 256 orders with [`walk_window`] flat to 128, or with Fejer's weights to
-//! 256 at the node pairs where the flat window rings below zero
+//! 256 at the node pairs where the flat window rings below zero (faces
+//! smoother than [`WALK_REFERENCE_ALPHA`] to more, [`walk_orders_for`])
 //! (crates/slab/src/bsdf.rs). Luster's peak at 75 degrees, 4.6-6.2% under
 //! the solve with twice the orders before, is now within 0.001% of it
 //! (tests/walk_orders.rs). Windows between the two (flat to 16, 32 or 48
@@ -827,6 +828,43 @@ pub(crate) fn column_albedo(k: &DMatrix<f64>, to: &Grid, from: &Grid, j: usize) 
 /// those points), and the
 /// chain on 13 of the 32 nodes costs a sixth.
 pub const WALK_GRAZING_MU: f64 = 0.5;
+
+/// The roughness `alpha` at and above which a face's walk is summed to the
+/// orders asked for ([`walk_orders_for`]): luster's Beckmann 0.15 front,
+/// whose forward peak at grazing incidence 256 orders resolve.
+pub const WALK_REFERENCE_ALPHA: f64 = 0.15;
+
+/// The most [`walk_orders_for`] multiplies the orders asked for by: 2.5,
+/// reached at `alpha = 0.06`. Smoother faces scatter too little more than
+/// once for their walk's peak to matter: under devB's sheet with 256 orders
+/// against 1024, Beckmann 0.05 and 0.04 fronts moved the in-plane
+/// reflection by 0.17% and 0.008% (0.06: 0.79%), and 960 orders for
+/// glossy's Beckmann 0.04 front cost 0.3 s more build (1.0 s) for no change
+/// the convergence example sees.
+pub const WALK_MOST_FACTOR: f64 = 2.5;
+
+/// The Fourier orders of the walk's reflection from outside for a face of
+/// roughness `alpha` when `walk_orders` are asked for a face of
+/// [`WALK_REFERENCE_ALPHA`] (0: none): `walk_orders` for rougher faces,
+/// `walk_orders * min(WALK_REFERENCE_ALPHA / alpha, WALK_MOST_FACTOR)`
+/// rounded up to a multiple of 64 for smoother ones, at most `max`. The
+/// walk's forward peak at grazing incidence narrows in azimuth as `alpha`
+/// does, so the orders it needs grow as `1 / alpha` (about `38 / alpha`):
+/// with 256 for every face, Beckmann fronts of 0.12, 0.1, 0.08 and 0.06
+/// under devB's sheet were 3.9%, 3.9%, 2.8% and 0.8% off the reflection
+/// with 1024 (at 80 R -80, in the plane from 50 to 80 degrees); with this
+/// rule doubling `walk_orders` (which doubles every face's orders) moves
+/// Beckmann 0.04 to 0.2 fronts by at most 0.001% there (a probe,
+/// 2026-12-06, not kept; tests/walk_orders.rs asserts it on luster with
+/// smoother fronts; README "Convergence").
+pub fn walk_orders_for(walk_orders: usize, alpha: f64, max: usize) -> usize {
+    if walk_orders == 0 || alpha >= WALK_REFERENCE_ALPHA || alpha <= 0.0 {
+        return walk_orders.min(max);
+    }
+    let factor = (WALK_REFERENCE_ALPHA / alpha).min(WALK_MOST_FACTOR);
+    let wanted = (walk_orders as f64 * factor / 64.0).ceil() as usize * 64;
+    wanted.min(max)
+}
 
 /// The window of the walk's reflection from outside summed to `big_m`
 /// orders (module doc): 1 to order `flat`, then linear to 0 at `big_m`. With

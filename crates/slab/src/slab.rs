@@ -30,14 +30,16 @@
 //! reflection from outside alone (what `crate::bsdf` replaces by the
 //! analytic face), the boundary's contribution is in [`Prepared::coating`].
 
+use crate::bsdf::MAX_ORDERS;
 use crate::error::SlabError;
 use crate::interface::{
-    column_albedo, face_interface, smooth_boundary, Compensation, ProjectedFace, Projection, DEFAULT_AZIMUTH_POINTS,
+    column_albedo, face_interface, smooth_boundary, walk_orders_for, Compensation, ProjectedFace, Projection,
+    DEFAULT_AZIMUTH_POINTS,
 };
 use crate::layer::{default_start_thickness, medium_layer, Layer};
 use crate::phase::{phase_fourier, validate, PhaseFourier};
 use crate::quad::Grid;
-use paperbsdf_core::dielectric::{ETA_RANGE, M_RANGE};
+use paperbsdf_core::dielectric::{Interface, ETA_RANGE, M_RANGE};
 use paperbsdf_core::phase::TwoLobeHg;
 use paperbsdf_core::{Distribution, FaceScattering, PaperParams, ParamError, RoughDielectric, Sheet};
 use rayon::prelude::*;
@@ -291,11 +293,16 @@ impl SlabSpec {
         let start = disc.start_thickness.unwrap_or_else(|| default_start_thickness(&inside));
         let project = |face: &Face, suffix: &str, below: &Grid| -> Result<ProjectedFace, SlabError> {
             let (bd, fs) = face.dielectric(suffix)?;
+            // Smoother faces' walks to more orders (`walk_orders_for`).
+            let walk_orders = match bd.interface {
+                Interface::Rough(mf) => walk_orders_for(disc.walk_orders, mf.alpha, MAX_ORDERS),
+                _ => disc.walk_orders,
+            };
             let proj = Projection {
                 orders: disc.orders,
                 azimuth_points: disc.azimuth_points,
                 normalise: disc.normalise_faces,
-                walk_orders: disc.walk_orders,
+                walk_orders,
             };
             face_interface(&bd, fs, &outside, below, &proj)
         };

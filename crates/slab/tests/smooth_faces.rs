@@ -65,7 +65,8 @@ fn totals(b: &SlabBsdf, wi: DVec3) -> (f64, f64) {
             wi.z.abs(),
             3,
             8,
-            272,
+            // Above the orders the table keeps (tests/slab_bsdf.rs, `TABLE_PHI`).
+            272.max(b.most_orders() + 16),
         )
     };
     let side = if wi.z > 0.0 { Side::Front } else { Side::Back };

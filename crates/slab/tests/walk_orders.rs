@@ -9,7 +9,7 @@
 
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::presets::preset;
-use paperbsdf_core::{Bsdf, DVec3};
+use paperbsdf_core::{Bsdf, DVec3, Distribution, PaperParams};
 use paperbsdf_slab::{SlabBsdf, SlabOptions};
 
 /// In-plane reflection at the walk's forward peak, lit from the front and
@@ -38,12 +38,33 @@ fn peak_values(b: &SlabBsdf) -> Vec<(String, f64)> {
 /// lit from the front, 1.1-1.2% from the back). Measured: at most 0.001%
 /// at 60 and 75 degrees. At 85 R -85 the walk's peak is narrower than 256
 /// orders resolve at the node pairs beyond 85 degrees, which keep Fejer's
-/// weights (src/bsdf.rs, `negative_mass`): 2.2% under (4.9% before),
-/// asserted within 3%.
+/// weights (src/bsdf.rs, `negative_mass`): 2.2% under (4.9% before).
+/// Luster with smoother fronts, Beckmann 0.1 and 0.08 (devB's), and GGX
+/// 0.06, whose walks take more orders than asked
+/// (`interface::walk_orders_for`: 384, 512 and 640): with 256 for every
+/// face the first two were 3.9% and 2.8% off at 80 R -80 on devB's sheet,
+/// now within 0.001% everywhere but 85 R -85 lit from the front, 3.4%,
+/// 3.5% and 2.4% under: the same pairs beyond 85 degrees with Fejer's
+/// weights, whose kernel (about `2 pi / M` wide) takes more off a narrower
+/// peak. 85 R -85 is asserted within 4%, outside the range
+/// (examples/convergence.rs stops at 80 degrees). Lit from the back
+/// (luster's Beckmann 0.3 back face, 256 orders) the light meets the
+/// smoother front's walk only after the sheet.
 #[test]
 fn the_walks_forward_peak_converges_in_the_orders() {
-    for name in ["luster", "matte"] {
-        let p = preset(name).unwrap();
+    let smoother = |m_f: f64, dist_f: Distribution| PaperParams {
+        m_f,
+        dist_f,
+        ..preset("luster").unwrap()
+    };
+    let sheets = [
+        ("luster", preset("luster").unwrap()),
+        ("matte", preset("matte").unwrap()),
+        ("luster, Beckmann 0.1 front", smoother(0.1, Distribution::Beckmann)),
+        ("luster, Beckmann 0.08 front", smoother(0.08, Distribution::Beckmann)),
+        ("luster, GGX 0.06 front", smoother(0.06, Distribution::Ggx)),
+    ];
+    for (name, p) in sheets {
         let base = SlabOptions::default();
         let with = |orders: usize, walk_orders: usize| {
             let o = SlabOptions {
@@ -65,7 +86,7 @@ fn the_walks_forward_peak_converges_in_the_orders() {
                 100.0 * rel,
                 100.0 * rel_old
             );
-            let bound = if at.contains(" 85 R ") { 3e-2 } else { 2e-3 };
+            let bound = if at.contains(" 85 R ") { 4e-2 } else { 2e-3 };
             assert!(rel.abs() < bound, "{name} {at}: {v} against {f} with twice the orders");
             assert!(
                 rel.abs() <= rel_old.abs() + 1e-4,
@@ -133,5 +154,41 @@ fn a_face_without_the_walk_beside_one_with_it() {
         let rel = v / f - 1.0;
         eprintln!("smooth front, rough back {at}: {v:.5} / {f:.5} {:+.3}%", 100.0 * rel);
         assert!(rel.abs() < 2e-3, "{at}: {v} against {f} with twice the orders");
+    }
+}
+
+/// The rule that gives each face its walk's orders
+/// (`interface::walk_orders_for`): the orders asked for at and above the
+/// reference roughness, in proportion to `1 / alpha` below it rounded up to
+/// a multiple of 64, at most 2.5 times, and never past the most orders; 0
+/// stays 0 (no walk orders asked). Doubling the orders asked doubles a
+/// face's (up to rounding to 64), which the convergence checks rely on.
+#[test]
+fn each_face_takes_orders_as_its_roughness_needs() {
+    use paperbsdf_slab::bsdf::MAX_ORDERS;
+    use paperbsdf_slab::interface::{walk_orders_for, WALK_MOST_FACTOR, WALK_REFERENCE_ALPHA};
+    assert_eq!(walk_orders_for(256, 0.3, MAX_ORDERS), 256);
+    assert_eq!(walk_orders_for(256, WALK_REFERENCE_ALPHA, MAX_ORDERS), 256);
+    // 256 * 0.15 / 0.1 = 384; 256 * 0.15 / 0.08 = 480 -> 512; 0.06: 640.
+    assert_eq!(walk_orders_for(256, 0.1, MAX_ORDERS), 384);
+    assert_eq!(walk_orders_for(256, 0.08, MAX_ORDERS), 512);
+    assert_eq!(walk_orders_for(256, 0.06, MAX_ORDERS), 640);
+    // Smoother: capped at 2.5 times.
+    for alpha in [0.05, 0.01, 1e-4] {
+        assert_eq!(
+            walk_orders_for(256, alpha, MAX_ORDERS),
+            (256.0 * WALK_MOST_FACTOR) as usize
+        );
+    }
+    assert_eq!(walk_orders_for(0, 0.05, MAX_ORDERS), 0);
+    assert_eq!(walk_orders_for(1024, 0.05, MAX_ORDERS), MAX_ORDERS);
+    assert_eq!(walk_orders_for(512, 0.3, 300), 300);
+    for alpha in [0.3, 0.15, 0.12, 0.1, 0.08, 0.07, 0.06, 0.04] {
+        let (a, b) = (
+            walk_orders_for(256, alpha, MAX_ORDERS),
+            walk_orders_for(512, alpha, MAX_ORDERS),
+        );
+        assert!(b >= 2 * a - 64 && b <= 2 * a, "alpha {alpha}: {a} then {b}");
+        assert!(a % 64 == 0 && a >= 256, "alpha {alpha}: {a}");
     }
 }
