@@ -189,7 +189,7 @@ use crate::error::SlabError;
 use crate::interface::{column_albedo, walk_window};
 use crate::quad::Grid;
 use crate::slab::{Discretisation, SlabSpec, Solution};
-use crate::two_crossings::{Between, TwoCrossings};
+use crate::two_crossings::{Between, TwoCrossings, ALBEDO_AZIMUTH_POINTS, ALBEDO_POINTS_PER_CELL};
 #[cfg(not(feature = "sse2-only"))]
 use multiversion::{multiversion, target::target_cfg_f};
 use nalgebra::DMatrix;
@@ -1953,15 +1953,40 @@ fn fourier_sum_pole<const K: usize>(
         .unwrap_or(0);
     with_series_buffer(longest, |a_m| {
         cos_series(&mut a_m[..longest], c, pole.r);
+        // The pole corners' own order 0 and their orders m >= 1.
+        let (mut own, mut high) = ([0.0f64; K], [0.0f64; K]);
         for (&p, &w) in pole.pairs.iter().zip(&pole.weights) {
             let (data, l, h) = tab.pair::<K>(st, p);
-            if w == 0.0 || l < 2 {
+            if w == 0.0 {
+                continue;
+            }
+            for (k, o) in own.iter_mut().enumerate() {
+                *o += w * data[k * h];
+            }
+            if l < 2 {
                 continue;
             }
             let s = pair_series::<K, false>(data, l, h, &a_m[..longest], 1);
-            for (x, v) in acc.iter_mut().zip(s) {
+            for (x, v) in high.iter_mut().zip(s) {
                 *x += w * v;
             }
+        }
+        // `own + high >= 0` wherever the corners' series are (the weights
+        // rho^m are Poisson's kernel, which is positive), so `high >= -own`;
+        // with the triangles' order 0 below the corners', the orders m >= 1
+        // scaled by their ratio keep the sum non-negative, and the
+        // azimuth's integral (order 0, the energy) is unchanged. Until
+        // 2026-12-06 they were added whole, and the sum went below zero
+        // away from a narrow lobe near the normal, where `eval` clamped it:
+        // a sheet of tau 0.3 with GGX 0.01 faces reflected and transmitted
+        // up to 1.0022 of the light 1-8 degrees from the normal.
+        for k in 0..K {
+            let scale = if own[k] > 0.0 && acc[k] < own[k] {
+                (acc[k] / own[k]).max(0.0)
+            } else {
+                1.0
+            };
+            acc[k] += scale * high[k];
         }
         acc
     })
@@ -2305,10 +2330,30 @@ impl SlabBsdf {
         // Per side and node: the unscattered terms' albedo reached, the
         // channels' mean (the weight of their sampling lobe).
         let mut unscattered_albedo: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
-        for (k, (term, proj)) in unscattered.iter_mut().zip(&unscattered_proj).enumerate() {
-            if let (Some(t), Some(pf), Some(pb)) = (term.as_mut(), proj[0].first(), proj[1].first()) {
-                let (t1, t2) = (albedo0(pf, 0, 1), albedo0(pb, 1, 0));
-                let reached = t.balance(&g.mu, &t1, &t2, Some([&shape_front, &shape_back]));
+        // The terms (one per distinct optical thickness) balanced in one
+        // pass over their rule (`TwoCrossings::balance_each`).
+        let balanced: Vec<usize> = (0..unscattered.len())
+            .filter(|&k| {
+                unscattered[k].is_some() && !unscattered_proj[k][0].is_empty() && !unscattered_proj[k][1].is_empty()
+            })
+            .collect();
+        let term_targets: Vec<(Vec<f64>, Vec<f64>)> = balanced
+            .iter()
+            .map(|&k| {
+                (
+                    albedo0(&unscattered_proj[k][0][0], 0, 1),
+                    albedo0(&unscattered_proj[k][1][0], 1, 0),
+                )
+            })
+            .collect();
+        let mut terms: Vec<TwoCrossings> = balanced.iter().filter_map(|&k| unscattered[k].take()).collect();
+        let pairs: Vec<(&[f64], &[f64])> = term_targets.iter().map(|(a, b)| (a.as_slice(), b.as_slice())).collect();
+        let reached_all = TwoCrossings::balance_each(&mut terms, &g.mu, &pairs, Some([&shape_front, &shape_back]));
+        for ((&k, t), reached) in balanced.iter().zip(terms).zip(reached_all) {
+            unscattered[k] = Some(t);
+            let proj = &unscattered_proj[k];
+            let (pf, pb) = (&proj[0][0], &proj[1][0]);
+            {
                 for (side, (p0, reached)) in [pf, pb].into_iter().zip(reached).enumerate() {
                     let channels = solution_of.iter().filter(|&&x| x == k).count() as f64 / 3.0;
                     let mean = &mut unscattered_albedo[side];
@@ -3046,19 +3091,29 @@ impl SlabBsdf {
     /// lobes' own half-vector coordinates
     /// ([`crate::two_crossings::TwoCrossings::albedo_of`]).
     pub fn analytic_albedo(&self, wi: DVec3) -> (Rgb, Rgb) {
+        self.analytic_albedo_with(wi, ALBEDO_POINTS_PER_CELL, ALBEDO_AZIMUTH_POINTS)
+    }
+
+    /// [`SlabBsdf::analytic_albedo`] by a rule of `per_cell` points on each
+    /// of the lobes' table intervals and `azimuth` points in azimuth
+    /// ([`TwoCrossings::albedo_with`]): the build balances the terms with
+    /// the default rule ([`ALBEDO_POINTS_PER_CELL`],
+    /// [`ALBEDO_AZIMUTH_POINTS`]), so a check of `eval`'s energy must
+    /// integrate them by a finer one, or it cannot see that rule's error.
+    pub fn analytic_albedo_with(&self, wi: DVec3, per_cell: usize, azimuth: usize) -> (Rgb, Rgb) {
         if wi.z == 0.0 {
             return (Rgb::ZERO, Rgb::ZERO);
         }
         let mu = wi.z.abs();
         let r = match (&self.coat, wi.z > 0.0) {
-            (Some(c), true) => c.albedo_of(mu, |a, b| c.eval(a, b)),
+            (Some(c), true) => c.albedo_with(mu, per_cell, azimuth, |a, b| c.eval(a, b)),
             _ => 0.0,
         };
         let t = self.unscattered_per_channel(|t| {
             if wi.z > 0.0 {
-                t.albedo_of(mu, |a, b| t.eval(a, b))
+                t.albedo_with(mu, per_cell, azimuth, |a, b| t.eval(a, b))
             } else {
-                t.albedo_of(mu, |a, b| t.eval(b, a))
+                t.albedo_with(mu, per_cell, azimuth, |a, b| t.eval(b, a))
             }
         });
         (Rgb::splat(r), t)

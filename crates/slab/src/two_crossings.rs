@@ -111,8 +111,25 @@ pub const TABLE_SIZE: [usize; 3] = [48, 24, 13];
 /// table's integrals.
 pub const TABLE_POINTS: usize = 8;
 
-/// Gauss-Legendre points per axis of [`TwoCrossings::albedo_of`].
-pub const ALBEDO_POINTS: usize = 48;
+/// Gauss-Legendre points of [`TwoCrossings::albedo_of`] on each of the
+/// table's intervals in `x`. The balance makes the albedo by this rule the
+/// target, so `eval`'s energy is off by the rule's error: until 2026-12-06
+/// the rule had 48 points over all of `x` (one per interval of the
+/// trilinear table, whose kinks it does not see), and a thin sheet's
+/// unscattered term (optical thickness 0.3, GGX 0.01 faces) integrated
+/// 0.2-0.4% below it at 80 degrees, 1-2% at 88 (against 400 points, and
+/// against this rule with 8 points per interval and 512 in azimuth): the
+/// sheet's `R + T` was 1 - 3.6e-3 (thin tissue, GGX 0.3: 2.8e-4), which
+/// the energy tests, integrating the term by the same rule, did not see.
+/// With 2 points per interval the rule is within 1e-4 of the term's albedo
+/// (tests/slab_bsdf.rs, `energy_closes_without_absorption`, by 6 x 256;
+/// examples/two_crossings.rs); 2 x 64 halved the largest error and cost
+/// the RGB thin sheet 0.14 s of build, 3 x 64 was no better.
+pub const ALBEDO_POINTS_PER_CELL: usize = 2;
+
+/// Gauss-Legendre points of [`TwoCrossings::albedo_of`] in the half
+/// vector's azimuth.
+pub const ALBEDO_AZIMUTH_POINTS: usize = 48;
 
 /// Where the half vector's slope is so large that every point of the table
 /// from there on is below this fraction of its largest value, `eval` is 0
@@ -436,7 +453,7 @@ impl TwoCrossings {
     /// `albedo_of`, so exact for it): a matrix scaling problem, solved by
     /// Sinkhorn's alternating iteration (for a symmetric term its
     /// symmetric form, the geometric mean of `r` and `t / (A r)`) to 1e-12
-    /// or [`BALANCE_ITERATIONS`]. The two faces' targets must carry the
+    /// or `BALANCE_ITERATIONS`. The two faces' targets must carry the
     /// same flux; where they do not (the projection's quadrature against
     /// the table's rule, about 1e-5 of it), the iteration stops once only
     /// the factors' common scale moves, and the caller takes up what the
@@ -445,10 +462,47 @@ impl TwoCrossings {
     /// and at the second (by the rule of `albedo_of`: equal to it to
     /// rounding, as `A` and `B` are).
     pub fn balance(&mut self, mu: &[f64], first: &[f64], second: &[f64], shapes: Option<Shapes>) -> [Vec<f64>; 2] {
+        let mut reached = Self::balance_each(std::slice::from_mut(self), mu, &[(first, second)], shapes);
+        reached.pop().expect("one term")
+    }
+
+    /// [`TwoCrossings::balance`] of several terms of one geometry (those of
+    /// [`TwoCrossings::unscattered_each`]: the same faces, so the same
+    /// table coordinates and rule, tables that differ by the attenuation),
+    /// `targets[k]` term `k`'s `(first, second)`: the tables' albedo on the
+    /// hat functions in one pass over the rule (each point's directions,
+    /// coordinates and hat placed once, then read from every table),
+    /// then each term's scaling. Returns each term's reached albedo.
+    /// Terms of different geometries are balanced one by one.
+    pub fn balance_each(
+        terms: &mut [TwoCrossings],
+        mu: &[f64],
+        targets: &[(&[f64], &[f64])],
+        shapes: Option<Shapes>,
+    ) -> Vec<[Vec<f64>; 2]> {
+        assert_eq!(terms.len(), targets.len(), "a target pair per term");
+        let Some(first) = terms.first() else {
+            return Vec::new();
+        };
+        let shared = terms.iter().all(|t| {
+            t.sigma == first.sigma
+                && t.folded == first.folded
+                && t.np == first.np
+                && t.values.len() == first.values.len()
+        });
+        if !shared {
+            return terms
+                .iter_mut()
+                .zip(targets)
+                .map(|(t, (a, b))| t.balance(mu, a, b, shapes))
+                .collect();
+        }
         let n = mu.len();
-        self.scale_mu = mu.to_vec();
         let points = STEPS * n + 1;
-        let fine: Vec<f64> = (0..points).map(|p| self.step_mu(p)).collect();
+        for t in terms.iter_mut() {
+            t.scale_mu = mu.to_vec();
+        }
+        let fine: Vec<f64> = (0..points).map(|p| terms[0].step_mu(p)).collect();
         // Values at the cosines, linear at the points between them.
         let lerp = |t: &[f64], p: usize| -> f64 {
             let k = STEPS;
@@ -462,13 +516,10 @@ impl TwoCrossings {
             let f = s as f64 / k as f64;
             t[i] * (1.0 - f) + t[i + 1] * f
         };
-        // The cosines where the factors are balanced, and their targets.
-        let (at, targets): (Vec<f64>, [Vec<f64>; 2]) = match shapes {
-            Some(g) => (
-                fine.clone(),
-                [(first, g[0]), (second, g[1])].map(|(t, g)| (0..points).map(|p| g(fine[p]) * lerp(t, p)).collect()),
-            ),
-            None => (mu.to_vec(), [first.to_vec(), second.to_vec()]),
+        // The cosines where the factors are balanced.
+        let at: Vec<f64> = match shapes {
+            Some(_) => fine.clone(),
+            None => mu.to_vec(),
         };
         let m = at.len();
         // Where a cosine falls among `at`: hat functions `i` and `i + 1`
@@ -483,30 +534,84 @@ impl TwoCrossings {
             let i = at.partition_point(|&x| x <= c).saturating_sub(1).min(m - 2);
             (i, (c - at[i]) / (at[i + 1] - at[i]))
         };
-        // Row p: the albedo at at[p] on each hat function of the exit
-        // cosine (before any factor).
-        let hats = |reverse: bool| -> Vec<Vec<f64>> {
-            at.par_iter()
+        // Per term, row p: the albedo at at[p] on each hat function of the
+        // exit cosine (before any factor). The rule reaches the largest
+        // `x_cut` (each table is 0 beyond its own, so a term's rows are
+        // those of its own rule).
+        let x_cut = terms.iter().map(|t| t.x_cut).fold(0.0, f64::max);
+        let geometry = &terms[0];
+        let count = terms.len();
+        let hats = |reverse: bool| -> Vec<Vec<Vec<f64>>> {
+            let rows: Vec<Vec<Vec<f64>>> = at
+                .par_iter()
                 .map(|&c| {
-                    let mut row = vec![0.0; m];
-                    self.rule_of(c, |wi, wo, weight| {
-                        let v = if reverse {
-                            self.eval_table(wo, wi)
-                        } else {
-                            self.eval_table(wi, wo)
-                        };
-                        if v != 0.0 {
+                    let mut row = vec![vec![0.0; m]; count];
+                    geometry.rule_within(
+                        x_cut,
+                        c,
+                        ALBEDO_POINTS_PER_CELL,
+                        ALBEDO_AZIMUTH_POINTS,
+                        |wi, wo, weight| {
+                            let (a, b) = if reverse { (wo, wi) } else { (wi, wo) };
+                            let Some(coords) = geometry.coordinates(a, b) else {
+                                return;
+                            };
                             let (i, t) = place(wo.z);
-                            row[i] += weight * v * (1.0 - t);
-                            if t > 0.0 {
-                                row[i + 1] += weight * v * t;
+                            for (term, row) in terms.iter().zip(row.iter_mut()) {
+                                let v = term.lookup(coords);
+                                if v != 0.0 {
+                                    row[i] += weight * v * (1.0 - t);
+                                    if t > 0.0 {
+                                        row[i + 1] += weight * v * t;
+                                    }
+                                }
                             }
-                        }
-                    });
+                        },
+                    );
                     row
                 })
+                .collect();
+            // Term-major.
+            (0..count)
+                .map(|k| rows.iter().map(|r| r[k].clone()).collect())
                 .collect()
         };
+        let a_all = hats(false);
+        let b_all = (!geometry.folded).then(|| hats(true));
+        let mut out = Vec::with_capacity(count);
+        for (k, term) in terms.iter_mut().enumerate() {
+            let (first, second) = targets[k];
+            let tg: [Vec<f64>; 2] = match shapes {
+                Some(g) => {
+                    [(first, g[0]), (second, g[1])].map(|(t, g)| (0..points).map(|p| g(fine[p]) * lerp(t, p)).collect())
+                }
+                None => [first.to_vec(), second.to_vec()],
+            };
+            let b = b_all.as_ref().map(|b| &b[k]);
+            out.push(term.scale_to(&a_all[k], b, &tg, &fine, n, shapes.is_some(), &lerp));
+        }
+        out
+    }
+
+    /// The matrix scaling of [`TwoCrossings::balance`] on the hat albedos
+    /// `a` (light at the first face) and `b` (at the second; `None` for a
+    /// symmetric term) to `targets` at the points `fine` (`shaped`: the
+    /// factors at every point; else at the `n` cosines, `lerp` between),
+    /// and the factors' lines and guide. Returns the albedo reached at the
+    /// cosines.
+    #[allow(clippy::too_many_arguments)]
+    fn scale_to(
+        &mut self,
+        a: &[Vec<f64>],
+        b: Option<&Vec<Vec<f64>>>,
+        targets: &[Vec<f64>; 2],
+        fine: &[f64],
+        n: usize,
+        shaped: bool,
+        lerp: &dyn Fn(&[f64], usize) -> f64,
+    ) -> [Vec<f64>; 2] {
+        let m = a.len();
+        let points = fine.len();
         let times = |k: &[Vec<f64>], r: &[f64]| -> Vec<f64> {
             k.iter()
                 .map(|row| row.iter().zip(r).map(|(a, b)| a * b).sum())
@@ -523,13 +628,11 @@ impl TwoCrossings {
             }
             change
         };
-        let a = hats(false);
-        let b = (!self.folded).then(|| hats(true));
         let (mut r1, mut r2) = (vec![1.0; m], vec![1.0; m]);
-        if let Some(b) = &b {
+        if let Some(b) = b {
             let mut last = f64::INFINITY;
             for _ in 0..BALANCE_ITERATIONS {
-                let k = times(&a, &r2);
+                let k = times(a, &r2);
                 let c1 = update(&mut r1, &k, &targets[0], false);
                 let k = times(b, &r1);
                 let c2 = update(&mut r2, &k, &targets[1], false);
@@ -543,7 +646,7 @@ impl TwoCrossings {
             }
         } else {
             for _ in 0..BALANCE_ITERATIONS {
-                let k = times(&a, &r1);
+                let k = times(a, &r1);
                 if update(&mut r1, &k, &targets[0], true) < 1e-12 {
                     break;
                 }
@@ -552,21 +655,22 @@ impl TwoCrossings {
         }
         // The albedo reached at the cosines (a symmetric term's the same
         // both ways), before the factors go to their points.
-        let node = |j: usize| if shapes.is_some() { STEPS * (j + 1) } else { j };
+        let node = |j: usize| if shaped { STEPS * (j + 1) } else { j };
         let reached_first: Vec<f64> = {
-            let k = times(&a, &r2);
+            let k = times(a, &r2);
             (0..n).map(|j| r1[node(j)] * k[node(j)]).collect()
         };
-        let reached_second = match &b {
+        let reached_second = match b {
             Some(b) => {
                 let k = times(b, &r1);
                 (0..n).map(|j| r2[node(j)] * k[node(j)]).collect()
             }
             None => reached_first.clone(),
         };
-        let values = match shapes {
-            Some(_) => [r1, r2],
-            None => [r1, r2].map(|r| (0..points).map(|p| lerp(&r, p)).collect()),
+        let values = if shaped {
+            [r1, r2]
+        } else {
+            [r1, r2].map(|r| (0..points).map(|p| lerp(&r, p)).collect())
         };
         // Each segment's line through its two points; the last constant.
         self.line = values.map(|v| {
@@ -586,50 +690,80 @@ impl TwoCrossings {
                 fine.partition_point(|&x| x <= at).saturating_sub(1) as u16
             })
             .collect();
-        self.points_mu = fine;
+        self.points_mu = fine.to_vec();
         [reached_first, reached_second]
     }
 
     /// `int f(wi, wo) mu_o dwo` for `wi` at cosine `mu` (azimuth 0) over
     /// the outgoing hemisphere, by the half vector `h` (`wo = 2 (wi.h) h -
     /// wi`, `dwo = 4 (wi.h) dh`) in the table's coordinate `x` (so the rule
-    /// gathers where the lobe is) and its azimuth, Gauss-Legendre
-    /// ([`ALBEDO_POINTS`] per axis; the lobe is even in the azimuth).
+    /// gathers where the lobe is) and its azimuth: Gauss-Legendre on each
+    /// of the table's intervals in `x` ([`ALBEDO_POINTS_PER_CELL`]; the
+    /// table is linear in `x` there) and in the azimuth
+    /// ([`ALBEDO_AZIMUTH_POINTS`]; the lobe is even in it).
     pub fn albedo_of(&self, mu: f64, f: impl Fn(DVec3, DVec3) -> f64) -> f64 {
+        self.albedo_with(mu, ALBEDO_POINTS_PER_CELL, ALBEDO_AZIMUTH_POINTS, f)
+    }
+
+    /// [`TwoCrossings::albedo_of`] with `per_cell` points on each of the
+    /// table's intervals in `x` and `azimuth` points in the half vector's
+    /// azimuth: a finer rule to check it by.
+    pub fn albedo_with(&self, mu: f64, per_cell: usize, azimuth: usize, f: impl Fn(DVec3, DVec3) -> f64) -> f64 {
         let mut sum = 0.0;
-        self.rule_of(mu, |wi, wo, weight| sum += weight * f(wi, wo));
+        self.rule_with(mu, per_cell, azimuth, |wi, wo, weight| sum += weight * f(wi, wo));
         sum
     }
 
-    /// The rule of [`TwoCrossings::albedo_of`]: calls `add(wi, wo, weight)`
-    /// at each of its points (`weight` includes `mu_o` and the rule's
-    /// Jacobian).
-    fn rule_of(&self, mu: f64, mut add: impl FnMut(DVec3, DVec3, f64)) {
+    /// The rule of [`TwoCrossings::albedo_with`]: calls `add(wi, wo,
+    /// weight)` at each of its points (`weight` includes `mu_o` and the
+    /// rule's Jacobian), with `per_cell` points per interval of the
+    /// table in `x` (up to `x_cut`, beyond which `eval` is 0) and `azimuth`
+    /// points in the half vector's azimuth.
+    fn rule_with(&self, mu: f64, per_cell: usize, azimuth: usize, add: impl FnMut(DVec3, DVec3, f64)) {
+        self.rule_within(self.x_cut, mu, per_cell, azimuth, add)
+    }
+
+    /// [`TwoCrossings::rule_with`] up to `x_cut` in `x`.
+    fn rule_within(
+        &self,
+        x_cut: f64,
+        mu: f64,
+        per_cell: usize,
+        azimuth: usize,
+        mut add: impl FnMut(DVec3, DVec3, f64),
+    ) {
         let wi = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
-        let (u, w) = gauss_legendre_01(ALBEDO_POINTS);
-        for (x, wx) in u.iter().zip(&w) {
-            // tan theta_h = sigma x / (1 - x).
-            let t = self.sigma * x / (1.0 - x);
-            let th = t.atan();
-            let dth = self.sigma / ((1.0 - x) * (1.0 - x) * (1.0 + t * t));
-            let (sh, ch) = th.sin_cos();
-            for (y, wy) in u.iter().zip(&w) {
-                let ph = std::f64::consts::PI * y;
-                let h = DVec3::new(sh * ph.cos(), sh * ph.sin(), ch);
-                let wh = wi.dot(h);
-                if wh <= 0.0 {
-                    continue;
+        let (u, w) = gauss_legendre_01(per_cell);
+        let (v, wv) = gauss_legendre_01(azimuth);
+        let nx = TABLE_SIZE[0] - 1;
+        let cells = ((x_cut * nx as f64).ceil() as usize).clamp(1, nx);
+        for cell in 0..cells {
+            for (xu, wxu) in u.iter().zip(&w) {
+                let x = (cell as f64 + xu) / nx as f64;
+                let wx = wxu / nx as f64;
+                // tan theta_h = sigma x / (1 - x).
+                let t = self.sigma * x / (1.0 - x);
+                let th = t.atan();
+                let dth = self.sigma / ((1.0 - x) * (1.0 - x) * (1.0 + t * t));
+                let (sh, ch) = th.sin_cos();
+                for (y, wy) in v.iter().zip(&wv) {
+                    let ph = std::f64::consts::PI * y;
+                    let h = DVec3::new(sh * ph.cos(), sh * ph.sin(), ch);
+                    let wh = wi.dot(h);
+                    if wh <= 0.0 {
+                        continue;
+                    }
+                    let wo = h * (2.0 * wh) - wi;
+                    if wo.z <= 0.0 {
+                        continue;
+                    }
+                    // Both signs of the azimuth: 2 pi in all.
+                    add(
+                        wi,
+                        wo,
+                        wx * wy * 2.0 * std::f64::consts::PI * dth * sh * 4.0 * wh * wo.z,
+                    );
                 }
-                let wo = h * (2.0 * wh) - wi;
-                if wo.z <= 0.0 {
-                    continue;
-                }
-                // Both signs of the azimuth: 2 pi in all.
-                add(
-                    wi,
-                    wo,
-                    wx * wy * 2.0 * std::f64::consts::PI * dth * sh * 4.0 * wh * wo.z,
-                );
             }
         }
     }
@@ -639,9 +773,16 @@ impl TwoCrossings {
         if wi.z <= 0.0 || wo.z <= 0.0 {
             return 0.0;
         }
-        let Some((x, yd, c2)) = self.coordinates(wi, wo) else {
-            return 0.0;
-        };
+        match self.coordinates(wi, wo) {
+            Some(coords) => self.lookup(coords),
+            None => 0.0,
+        }
+    }
+
+    /// The table at its coordinates `(x, yd, c2)` ([`TwoCrossings::coordinates`]):
+    /// trilinear, 0 beyond `x_cut`.
+    #[inline]
+    fn lookup(&self, (x, yd, c2): (f64, f64, f64)) -> f64 {
         if x > self.x_cut {
             return 0.0;
         }

@@ -283,15 +283,31 @@ fn energy_is_bounded() {
 /// scattering sheet (optical thickness 0.2 with a GGX 0.1 front: its
 /// unscattered light makes the narrowest table lobes, where the
 /// interpolation in `mu_o` integrated 4% above 1 before the tables were
-/// balanced), both sides, every 5 degrees from normal to 85 degrees (nodes
-/// and between them, where the interpolation in `mu_i` left 4e-4 before the
-/// crossing shapes).
+/// balanced), and one of optical thickness 0.3 between GGX 0.01 faces
+/// (the unscattered light most of the transmission), both sides, every 5
+/// degrees from normal to 85 degrees (nodes and between them, where the
+/// interpolation in `mu_i` left 4e-4 before the crossing shapes), at 1, 2
+/// and 3 degrees (within the last node interval, where the orders `m >= 1`
+/// are carried from the node before the pole: until 2026-12-06 their sum
+/// went below zero away from a narrow lobe and `eval`'s clamp gave the GGX
+/// 0.01 sheet up to 2.2e-3 more light than it received, `fourier_sum_pole`
+/// in src/bsdf.rs) and at 88 degrees (the table and analytic terms only,
+/// as on the GGX 0.01 sheet everywhere: the rule over `wo` does not
+/// resolve the face's lobe there).
 ///
-/// What `slab` adds to the lit face is the table (components `direct` +
-/// `multiple`): its integral plus the face's reflectance as `slab` takes it
-/// (`SlabBsdf::face_reflectance`: the analytic lobe's albedo integrated at
-/// the nodes over the micro-normal, `face_albedo`) must be 1 within 2e-5
-/// (measured: 8.6e-6; the rule is exact for the table's Fourier sum in
+/// What `slab` adds to the lit face is `eval` less the lit face's lobe
+/// (component `surface`; the table, clamped as `eval` clamps it, and the
+/// analytic terms): its integral plus the face's reflectance as `slab`
+/// takes it (`SlabBsdf::face_reflectance`: the analytic lobe's albedo
+/// integrated at the nodes over the micro-normal, `face_albedo`) must be 1
+/// within 1e-4, the bound (measured: 9.1e-5 at 88 degrees on the
+/// GGX 0.01 sheet, 5.5e-5 at 70 degrees on the thin one with a GGX 0.1
+/// front; 1.0e-5 with the analytic terms integrated by the rule the build
+/// balances them with, which cannot see that rule's own error: that was
+/// this test's rule until 2026-12-06, when the build's rule had one point
+/// per table interval and `eval` was 3.6e-3 off on the GGX 0.01 sheet and
+/// 1.2e-3 on the GGX 0.1 one, see [`ANALYTIC_RULE`]; the rule for the
+/// table is exact for the table's Fourier sum in
 /// azimuth and, with three points on each of [`SURFACE_SPLIT`] parts per
 /// interval, nearly so in `mu_o`: 8.2e-6 with six points on 32 parts, where
 /// it is exact for the crossing shapes' linear steps; six points on the
@@ -309,9 +325,23 @@ fn energy_is_bounded() {
 /// place of `face_albedo`, which differs from its own lobe's integral by
 /// 1e-4 at normal incidence (the coated Beckmann 0.25 front) and up to
 /// 1.7e-3 at grazing, this was 1.15e-4 up to 50 degrees.
+/// Points per table interval in `x` and in azimuth of the rule that
+/// integrates the analytic lobes (`SlabBsdf::analytic_albedo_with`): three
+/// and five times the build's (2 and 48). With the build's own rule the
+/// test cannot see that rule's error: until 2026-12-06 it had one point
+/// per interval and left `eval` 2-4e-3 of the term's albedo from its
+/// integral at 80 degrees (a thin sheet's unscattered light through GGX
+/// 0.01 faces), which this test, then using that rule, passed (measured
+/// with this one: examples/two_crossings.rs prints the build's rule against
+/// it).
+const ANALYTIC_RULE: (usize, usize) = (6, 256);
 /// Parts per node interval of the rule in `mu_o`.
 const SURFACE_SPLIT: usize = 8;
-/// Azimuth points of the table's albedo: above the default walk orders (256).
+/// Azimuth points of the table's albedo: above the default walk orders
+/// (256), and above the most orders the sheet keeps where a face's walk has
+/// more (`SlabBsdf::most_orders`; the midpoint rule on the circle integrates
+/// `cos(m phi)` exactly for `m` below its points: with 272 points a GGX 0.1
+/// front's 384 orders aliased, 2.8e-4 at 85 degrees).
 const TABLE_PHI: usize = 272;
 /// Azimuths of the rule for the analytic lobe.
 const SURFACE_PHI: usize = 768;
@@ -340,23 +370,31 @@ fn energy_closes_without_absorption() {
             [(1.5, 0.1, Distribution::Ggx), (1.5, 0.3, Distribution::Beckmann)],
             FaceScattering::Multiple,
         ),
+        // Optical thickness 0.3 between GGX 0.01 faces: the unscattered
+        // light is most of the transmission and the table's lobes are
+        // narrowest near the normal.
+        sheet(
+            0.001,
+            0.0,
+            300.0,
+            [(1.5, 0.01, Distribution::Ggx), (1.5, 0.01, Distribution::Ggx)],
+            FaceScattering::Multiple,
+        ),
     ];
     let (mut worst_table, mut worst_total, mut worst_lobe) = (0.0f64, 0.0f64, 0.0f64);
     for (k, p) in sheets.iter().enumerate() {
         let b = SlabBsdf::new(p).unwrap();
         for side in [1.0, -1.0] {
             let face = if side > 0.0 { Side::Front } else { Side::Back };
-            for theta in (0..18).map(|i| 5.0 * i as f64) {
+            let thetas = (0..18).map(|i| 5.0 * i as f64).chain([1.0, 2.0, 3.0, 88.0]);
+            for theta in thetas {
                 let wi = dir(theta, 0.2, side);
-                // The analytic lobes of `direct` (a coated front's round
-                // trip, the unscattered transmission) by their own rule.
-                let (r_analytic, t_analytic) = b.analytic_albedo(wi);
+                // The analytic lobes (a coated front's round trip, the
+                // unscattered transmission) by a finer rule than the one
+                // the build balances them with (ANALYTIC_RULE).
+                let (r_analytic, t_analytic) = b.analytic_albedo_with(wi, ANALYTIC_RULE.0, ANALYTIC_RULE.1);
                 let table = grid_albedo(
-                    |wo| {
-                        (b.eval_component(wi, wo, Component::Direct) + b.eval_component(wi, wo, Component::Multiple)
-                            - b.analytic_at(wi, wo))
-                        .mean()
-                    },
+                    |wo| (b.eval(wi, wo) - b.eval_component(wi, wo, Component::Surface) - b.analytic_at(wi, wo)).mean(),
                     b.nodes(),
                     wi.z.abs(),
                     3,
@@ -366,9 +404,16 @@ fn energy_closes_without_absorption() {
                 let e = table + b.face_reflectance(face, wi.z.abs()) - 1.0;
                 worst_table = worst_table.max(e.abs());
                 assert!(
-                    e.abs() < 2e-5,
+                    e.abs() < 1e-4,
                     "sheet {k}: table + face = 1 {e:+.2e} at theta {theta} side {side}"
                 );
+                // At 88 degrees the rule over `wo` does not resolve the
+                // face's lobe two degrees from the horizon (GGX 0.1: 1.7e-3
+                // off face_reflectance), nor GGX 0.01's anywhere (1.3e-4
+                // at 60 degrees); the table is checked there.
+                if theta > 85.0 || k == 3 {
+                    continue;
+                }
                 let surface = grid_albedo(
                     |wo| b.eval_component(wi, wo, Component::Surface).mean(),
                     b.nodes(),
