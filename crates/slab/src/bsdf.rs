@@ -3119,6 +3119,15 @@ impl SlabBsdf {
         (Rgb::splat(r), t)
     }
 
+    /// The table at `(wi, wo)` and its unscattered part, each clamped at 0
+    /// as `eval` clamps the table.
+    fn table_parts(&self, wi: DVec3, wo: DVec3) -> (Rgb, Rgb) {
+        (
+            self.eval_table(&self.table, wi, wo).map(|x| x.max(0.0)),
+            self.eval_table(&self.direct, wi, wo).map(|x| x.max(0.0)),
+        )
+    }
+
     /// The continuous part of `f` (the table, clamped at 0, plus the analytic surface reflection).
     fn eval_all(&self, wi: DVec3, wo: DVec3) -> Rgb {
         self.eval_all_at(wi, wo, self.place(wi), self.place(wo), cos_phi(wi, wo))
@@ -3251,13 +3260,20 @@ impl ComponentModel for SlabBsdf {
                     Rgb::ZERO
                 }
             }
+            // The table's unscattered part, clamped at 0 and at the whole
+            // table as `eval` clamps it (so that the components sum to
+            // `eval` where either series rings below zero; until 2026-12-06
+            // each was clamped on its own, and their sum exceeded `eval`
+            // there: a thin sheet between GGX 0.01 faces near the normal).
             Component::Direct => {
-                self.eval_table(&self.direct, wi, wo).map(|x| x.max(0.0))
+                let (whole, part) = self.table_parts(wi, wo);
+                Rgb(std::array::from_fn(|k| part.0[k].min(whole.0[k])))
                     + Rgb::splat(self.coat_at(wi, wo))
                     + self.unscattered_at(wi, wo)
             }
             Component::Multiple => {
-                (self.eval_table(&self.table, wi, wo) - self.eval_table(&self.direct, wi, wo)).map(|x| x.max(0.0))
+                let (whole, part) = self.table_parts(wi, wo);
+                Rgb(std::array::from_fn(|k| whole.0[k] - part.0[k].min(whole.0[k])))
             }
             Component::Single => Rgb::ZERO,
         }
