@@ -47,6 +47,20 @@ fn sheet(d: f64, sa: f64, ss: f64, faces: [(f64, f64, Distribution); 2], fs: Fac
     }
 }
 
+/// Optical thickness 0.3 between GGX 0.01 faces, without absorption: the
+/// unscattered light is most of the transmission, and the table's lobes are
+/// the narrowest (near the normal; seen backwards at grazing angles its
+/// parts ring below zero).
+fn thin_between_smooth_faces() -> PaperParams {
+    sheet(
+        0.001,
+        0.0,
+        300.0,
+        [(1.5, 0.01, Distribution::Ggx), (1.5, 0.01, Distribution::Ggx)],
+        FaceScattering::Multiple,
+    )
+}
+
 fn cases() -> Vec<(&'static str, PaperParams)> {
     use Distribution::{Beckmann, Ggx};
     let mut v = vec![
@@ -370,16 +384,7 @@ fn energy_closes_without_absorption() {
             [(1.5, 0.1, Distribution::Ggx), (1.5, 0.3, Distribution::Beckmann)],
             FaceScattering::Multiple,
         ),
-        // Optical thickness 0.3 between GGX 0.01 faces: the unscattered
-        // light is most of the transmission and the table's lobes are
-        // narrowest near the normal.
-        sheet(
-            0.001,
-            0.0,
-            300.0,
-            [(1.5, 0.01, Distribution::Ggx), (1.5, 0.01, Distribution::Ggx)],
-            FaceScattering::Multiple,
-        ),
+        thin_between_smooth_faces(),
     ];
     let (mut worst_table, mut worst_total, mut worst_lobe) = (0.0f64, 0.0f64, 0.0f64);
     for (k, p) in sheets.iter().enumerate() {
@@ -604,16 +609,7 @@ fn coated_smooth_delta_lobes_match_the_solver() {
 #[test]
 fn components_sum_to_eval() {
     let mut sheets = cases();
-    sheets.push((
-        "tau 0.3 between GGX 0.01 faces",
-        sheet(
-            0.001,
-            0.0,
-            300.0,
-            [(1.5, 0.01, Distribution::Ggx), (1.5, 0.01, Distribution::Ggx)],
-            FaceScattering::Multiple,
-        ),
-    ));
+    sheets.push(("tau 0.3 between GGX 0.01 faces", thin_between_smooth_faces()));
     for (name, p) in sheets {
         let b = SlabBsdf::new(&p).unwrap();
         let mut pairs = vec![
