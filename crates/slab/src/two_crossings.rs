@@ -86,12 +86,16 @@
 //! **Costs** (examples/two_crossings.rs prints them, 2026-12-06): a coated
 //! front's table 106-111 ms (GGX 0.3: 66) and its balance 2-5 ms of a
 //! build on two cores; the unscattered term's table 62 ms for equal GGX
-//! faces (thin tissue) and 147 ms for unequal ones, its balance 35-36 ms
-//! (60); 143 kB (254 for unequal faces); `eval` about 35 ns. A coloured
-//! sheet's distinct optical thicknesses share one pass over the entries
-//! ([`TwoCrossings::unscattered_each`]; a thin RGB sheet with GGX 0.1 and
-//! Beckmann 0.25 faces builds in 1.07 s, 0.68 s before the term; with a
-//! pass per channel about 1.4 s, from a run beside CI: 2.8 s against 2.1). A table of
+//! faces (thin tissue) and 147 ms for unequal ones, its balance 41-45 ms
+//! (82; 35-36 and 60 with the coarser rule before 2026-12-06,
+//! [`ALBEDO_POINTS_PER_CELL`]); 143 kB (254 for unequal faces); `eval` about
+//! 35 ns. A coloured sheet's distinct optical thicknesses share one pass
+//! over the entries ([`TwoCrossings::unscattered_each`]) and one over the
+//! balance's rule ([`TwoCrossings::balance_each`]): a thin RGB sheet with
+//! GGX 0.1 and Beckmann 0.25 faces builds in 0.92 s (1.07 s with a balance
+//! per channel and the coarser rule, 0.68 s before the term; with a pass
+//! per channel over the entries about 1.4 s, from a run beside CI: 2.8 s
+//! against 2.1; examples/slab_build, `rgb-thin-unequal`). A table of
 //! logarithms, tried for the round trip, undercut the narrow lobes' energy
 //! by up to 3.9% and its `exp` cost 8 ns more.
 
