@@ -230,7 +230,8 @@ pub struct SlabOptions {
     /// smoother face takes more, in proportion to `1 / alpha` and at most
     /// 2.5 times ([`crate::interface::walk_orders_for`]; devB's Beckmann
     /// 0.08 front 512, which moved its reflection at 80 R -80 by 2.8% when
-    /// it had 256; builds 0.75 -> 0.86 s). At grazing incidence on a smooth face
+    /// it had 256; devB builds in 0.75 s with it, examples/slab_build). At
+    /// grazing incidence on a smooth face
     /// this light is a forward peak narrower in azimuth than `orders`
     /// resolve (luster's Beckmann 0.15 front lit at 75 degrees, seen at 80:
     /// 6.2% under its converged value with 48 orders, Fejer-summed; now
@@ -2351,18 +2352,16 @@ impl SlabBsdf {
         let reached_all = TwoCrossings::balance_each(&mut terms, &g.mu, &pairs, Some([&shape_front, &shape_back]));
         for ((&k, t), reached) in balanced.iter().zip(terms).zip(reached_all) {
             unscattered[k] = Some(t);
-            let proj = &unscattered_proj[k];
-            let (pf, pb) = (&proj[0][0], &proj[1][0]);
-            {
-                for (side, (p0, reached)) in [pf, pb].into_iter().zip(reached).enumerate() {
-                    let channels = solution_of.iter().filter(|&&x| x == k).count() as f64 / 3.0;
-                    let mean = &mut unscattered_albedo[side];
-                    mean.resize(n, 0.0);
-                    for (j, have) in reached.into_iter().enumerate() {
-                        mean[j] += channels * have;
-                        for (c, _) in solution_of.iter().enumerate().filter(|(_, &x)| x == k) {
-                            adjust[1][side][j].0[c] = lost(p0, side, j) - have;
-                        }
+            // The channels' share of this term (its weight in their mean).
+            let channels = solution_of.iter().filter(|&&x| x == k).count() as f64 / 3.0;
+            for (side, reached) in reached.into_iter().enumerate() {
+                let p0 = &unscattered_proj[k][side][0];
+                let mean = &mut unscattered_albedo[side];
+                mean.resize(n, 0.0);
+                for (j, have) in reached.into_iter().enumerate() {
+                    mean[j] += channels * have;
+                    for (c, _) in solution_of.iter().enumerate().filter(|(_, &x)| x == k) {
+                        adjust[1][side][j].0[c] = lost(p0, side, j) - have;
                     }
                 }
             }

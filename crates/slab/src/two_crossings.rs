@@ -575,10 +575,14 @@ impl TwoCrossings {
                     row
                 })
                 .collect();
-            // Term-major.
-            (0..count)
-                .map(|k| rows.iter().map(|r| r[k].clone()).collect())
-                .collect()
+            // Term-major, each row moved to its term.
+            let mut per_term: Vec<Vec<Vec<f64>>> = (0..count).map(|_| Vec::with_capacity(m)).collect();
+            for r in rows {
+                for (term, row) in per_term.iter_mut().zip(r) {
+                    term.push(row);
+                }
+            }
+            per_term
         };
         let a_all = hats(false);
         let b_all = (!geometry.folded).then(|| hats(true));
@@ -714,20 +718,18 @@ impl TwoCrossings {
     /// azimuth: a finer rule to check it by.
     pub fn albedo_with(&self, mu: f64, per_cell: usize, azimuth: usize, f: impl Fn(DVec3, DVec3) -> f64) -> f64 {
         let mut sum = 0.0;
-        self.rule_with(mu, per_cell, azimuth, |wi, wo, weight| sum += weight * f(wi, wo));
+        self.rule_within(self.x_cut, mu, per_cell, azimuth, |wi, wo, weight| {
+            sum += weight * f(wi, wo)
+        });
         sum
     }
 
     /// The rule of [`TwoCrossings::albedo_with`]: calls `add(wi, wo,
     /// weight)` at each of its points (`weight` includes `mu_o` and the
-    /// rule's Jacobian), with `per_cell` points per interval of the
-    /// table in `x` (up to `x_cut`, beyond which `eval` is 0) and `azimuth`
-    /// points in the half vector's azimuth.
-    fn rule_with(&self, mu: f64, per_cell: usize, azimuth: usize, add: impl FnMut(DVec3, DVec3, f64)) {
-        self.rule_within(self.x_cut, mu, per_cell, azimuth, add)
-    }
-
-    /// [`TwoCrossings::rule_with`] up to `x_cut` in `x`.
+    /// rule's Jacobian), with `per_cell` points per interval of the table
+    /// in `x` up to `x_cut` (the term's own, beyond which `eval` is 0, or a
+    /// larger one shared by terms of one geometry) and `azimuth` points in
+    /// the half vector's azimuth.
     fn rule_within(
         &self,
         x_cut: f64,
