@@ -49,6 +49,19 @@ fn bench(c: &mut Criterion) {
                 black_box(&b).eval(d.0, d.1)
             })
         });
+        // Both directions 5-20 degrees from the normal, off the nodes: the
+        // odd orders take their ratio there (`ODD_ORDER_BAND`), two series
+        // per corner instead of one.
+        let dn = (
+            DVec3::new(-0.12, 0.05, -0.99).normalize(),
+            DVec3::new(0.2, 0.1, 0.97).normalize(),
+        );
+        c.bench_function(&format!("slab/{name}/eval_near_normal"), |bn| {
+            bn.iter(|| {
+                let d = black_box(&dn);
+                black_box(&b).eval(d.0, d.1)
+            })
+        });
         // Grazing, near the mirror direction (off the nodes): the node pairs
         // there keep the most Fourier orders (the lit face's walk, to
         // `SlabOptions::walk_orders`), the worst case of `eval`.
