@@ -1649,6 +1649,12 @@ fn cosine_sums(c: &[f64], at: Samples) -> Vec<f64> {
 /// balanced to.
 const RING_TOLERANCE: f64 = 1e-5;
 
+/// Bisection steps for a node pair's share of Fejer's weights (the walk's
+/// window, `with_options`): the share to `2^-12`. The pair's negative mass
+/// (`negative_mass`) is convex in the share (the sum is linear in it), so
+/// the least share within [`RING_TOLERANCE`] is where bisection ends.
+const FEJER_SHARE_STEPS: usize = 12;
+
 /// How much energy a node pair's series may add through `eval`'s clamp
 /// before [`fejer_where_ringing`] gives it Fejer's weights: the mean over
 /// azimuth of its negative part ([`negative_mass`]) times the quadrature
@@ -2594,10 +2600,19 @@ impl SlabBsdf {
             // (window flat to half of them) rings below zero by more than
             // RING_TOLERANCE of their mean where Fejer's weights to the same
             // orders would not (the walk's peak narrower than even those
-            // orders resolve: luster's Beckmann 0.15 front beyond 85
-            // degrees, GGX 0.1 at 85) take Fejer's weights: `eval` clamps at
-            // 0, which would add that energy.
-            let ks = if grey { 1 } else { 3 };
+            // orders resolve: luster's Beckmann 0.15 front beyond 82
+            // degrees, GGX 0.1 at 85) take part of Fejer's weights, the
+            // least that keeps every channel within that: `eval` clamps at
+            // 0, which would add that energy. Until 2026-12-06 they took
+            // Fejer's whole, a step along the mirror ridge where the pairs
+            // began to ring (luster: 82 degrees on 32 nodes, 80.8 on 64,
+            // whose ridge dipped by 8% there), which was luster's largest
+            // change with twice the nodes (1.02% at 80 R -80, now 0.78% at
+            // 71 R -71; examples/convergence.rs), and it broadened the
+            // peak beyond: 85 R -85 was 2.2% under twice the orders, now
+            // 1.2% (tests/walk_orders.rs). One share for the three
+            // channels (their orders past the solution's stay proportional,
+            // summed once), the largest any of them needs.
             // What pair (o, j)'s order m gains when Fejer's weights replace the flat window.
             let to_fejer = |o: usize, j: usize, m: usize| -> f64 {
                 if m == 0 || m >= count || o == n - 1 || j == n - 1 {
@@ -2605,49 +2620,81 @@ impl SlabBsdf {
                 }
                 walk_r[m][(o, j)] * (walk_window(m, count, 0) - walk_window(m, count, flat)) * scale_r(o, j)
             };
-            let rings = |o: usize, j: usize| -> bool {
+            // The share `s` of Fejer's weights pair (o, j) takes: its
+            // orders are the flat window's plus `s` times what Fejer's add
+            // (`to_fejer`), the least `s` whose sum rings below zero by at
+            // most RING_TOLERANCE of the pair's mean more than with Fejer's
+            // (0 where the flat window does not ring; the negative mass is
+            // convex in `s`, so bisection finds it).
+            let ks = if grey { 1 } else { 3 };
+            let share = |o: usize, j: usize| -> f64 {
                 let p = o * n + j;
                 let mean = table[side][0][p * m_solved];
-                // The walk's orders past the flat part bound how far the
-                // flat window's sum is from the (non-negative) whole series,
-                // and so its negative part: most pairs end here.
                 let beyond: f64 = walk_r[flat + 1..].iter().map(|w| w[(o, j)].abs()).sum::<f64>() * scale_r(o, j);
                 if (0..ks).all(|k| beyond <= RING_TOLERANCE * mean.0[k].abs()) {
-                    return false;
+                    return 0.0;
                 }
                 let high = &extra[side][p * extra_len..(p + 1) * extra_len];
                 let change: Vec<f64> = (0..m_count).map(|m| to_fejer(o, j, m)).collect();
-                (0..ks).any(|k| {
-                    let excess: f64 = [&table[side][0], &direct[side][0]]
+                let series: Vec<Vec<Rgb>> = [&table[side][0], &direct[side][0]]
+                    .iter()
+                    .map(|tab| {
+                        tab[p * m_solved..(p + 1) * m_solved]
+                            .iter()
+                            .chain(high)
+                            .copied()
+                            .collect()
+                    })
+                    .collect();
+                let with = |s: f64| -> Vec<Vec<Rgb>> {
+                    series
                         .iter()
-                        .map(|tab| {
-                            let series: Vec<Rgb> = tab[p * m_solved..(p + 1) * m_solved]
-                                .iter()
-                                .chain(high)
-                                .copied()
-                                .collect();
-                            let fejer: Vec<Rgb> =
-                                series.iter().zip(&change).map(|(v, d)| *v + Rgb::splat(*d)).collect();
-                            negative_mass(&series, k) - negative_mass(&fejer, k)
-                        })
-                        .sum();
-                    excess > RING_TOLERANCE * mean.0[k].abs()
-                })
+                        .map(|v| v.iter().zip(&change).map(|(x, d)| *x + Rgb::splat(s * d)).collect())
+                        .collect()
+                };
+                let fejer = with(1.0);
+                let floor: Vec<f64> = (0..ks)
+                    .map(|k| fejer.iter().map(|v| negative_mass(v, k)).sum())
+                    .collect();
+                let rings_at = |s: f64| -> bool {
+                    let v = with(s);
+                    (0..ks).any(|k| {
+                        let excess = v.iter().map(|v| negative_mass(v, k)).sum::<f64>() - floor[k];
+                        excess > RING_TOLERANCE * mean.0[k].abs()
+                    })
+                };
+                if !rings_at(0.0) {
+                    return 0.0;
+                }
+                let (mut lo, mut hi) = (0.0, 1.0);
+                for _ in 0..FEJER_SHARE_STEPS {
+                    let mid = 0.5 * (lo + hi);
+                    if rings_at(mid) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                hi
             };
-            let fallback: Vec<(usize, usize)> = (0..n * n)
+            let fallback: Vec<(usize, usize, f64)> = (0..n * n)
                 .into_par_iter()
                 .filter_map(|p| {
                     let (o, j) = (p / n, p % n);
                     // A pair and its reciprocal are the same series up to a
                     // positive factor: one check for both.
-                    (o <= j && rings(o, j)).then_some((o, j))
+                    if o > j {
+                        return None;
+                    }
+                    let s = share(o, j);
+                    (s > 0.0).then_some((o, j, s))
                 })
                 .collect();
-            for (a, b) in fallback {
+            for (a, b, sh) in fallback {
                 for (o, j) in [(a, b), (b, a)] {
                     let p = o * n + j;
                     for m in 1..m_count {
-                        let d = Rgb::splat(to_fejer(o, j, m));
+                        let d = Rgb::splat(sh * to_fejer(o, j, m));
                         if m < m_solved {
                             table[side][0][p * m_solved + m] += d;
                             direct[side][0][p * m_solved + m] += d;

@@ -146,8 +146,10 @@
 //! outside states at the grazing nodes ([`WALK_GRAZING_MU`],
 //! [`crate::face_walk::outside_reflection`]; luster's orders 48 to 96 from
 //! it are within 8e-6 of the full chain's). The `slab` model sums it to
-//! 256 orders with [`walk_window`] flat to 128, or with Fejer's weights to
-//! 256 at the node pairs where the flat window rings below zero (faces
+//! 256 orders with [`walk_window`] flat to 128, with part of Fejer's
+//! weights to 256 at the node pairs where the flat window rings below
+//! zero (the least share that keeps it within tolerance; Fejer's whole
+//! until 2026-12-06, a step along the mirror ridge) (faces
 //! smoother than [`WALK_REFERENCE_ALPHA`] to more, [`walk_orders_for`])
 //! (crates/slab/src/bsdf.rs). Luster's peak at 75 degrees, 4.6-6.2% under
 //! the solve with twice the orders before, is now within 0.001% of it

@@ -663,6 +663,14 @@ fn components_sum_to_eval() {
 /// `Tables::head`), a different grouping of the same sum, so the tolerance
 /// has an absolute floor of 1e-15 (1e-12 of 1e-3; the coefficients are of
 /// order 1e-3 to 10, and a component near 1e-8 moved by 1e-10 of itself).
+/// One exception, by design: where the lit face's walk rings at grazing
+/// reflection pairs, the pair takes a share of Fejer's weights that no
+/// channel rings with (src/bsdf.rs, `FEJER_SHARE_STEPS`), one share for the
+/// three channels so that their orders past the solution's stay
+/// proportional and are summed once; the RGB sheet's more absorbing
+/// channels can ask for a little more than the grey sheet's own. There
+/// (reflection with a direction beyond 80 degrees) within 1e-5 of the
+/// value (measured 1.9e-6).
 #[test]
 fn grey_sheet_is_the_rgb_sheet_channel() {
     let grey = preset("luster").unwrap();
@@ -674,27 +682,35 @@ fn grey_sheet_is_the_rgb_sheet_channel() {
         ..grey.clone()
     };
     let (g, c) = (SlabBsdf::new(&grey).unwrap(), SlabBsdf::new(&rgb).unwrap());
-    let mut n = 0;
+    let (mut n, mut worst_grazing) = (0, 0.0f64);
     for (ti, pi) in [(0.2, 0.0), (33.0, 0.4), (61.0, 1.1), (84.0, 2.9)] {
         for (to, po) in [(0.5, 0.3), (17.0, 2.0), (47.0, 0.0), (79.0, 3.1), (88.0, 1.6)] {
             for (si, so) in [(1.0, 1.0), (1.0, -1.0), (-1.0, -1.0), (-1.0, 1.0)] {
                 let (wi, wo) = (dir(ti, pi, si), dir(to, po, so));
                 let want = c.eval(wi, wo).0[0];
                 let got = g.eval(wi, wo);
+                // Reflection with either direction beyond 80 degrees may
+                // meet a pair whose walk window the other channels set.
+                let tol = if si == so && ti.max(to) > 80.0 { 1e-5 } else { 1e-12 };
+                let e = (got.0[0] - want).abs() / want.abs().max(1e-3);
+                worst_grazing = worst_grazing.max(if tol > 1e-12 { e } else { 0.0 });
                 assert!(
-                    (got.0[0] - want).abs() <= 1e-12 * want.abs().max(1e-3),
+                    e <= tol,
                     "eval({ti},{pi},{si} -> {to},{po},{so}): grey {got:?}, rgb channel 0 {want}"
                 );
                 assert!(got.0[0] == got.0[1] && got.0[1] == got.0[2], "grey eval {got:?}");
                 for &k in g.components() {
                     let (a, b) = (g.eval_component(wi, wo, k).0[0], c.eval_component(wi, wo, k).0[0]);
-                    assert!((a - b).abs() <= 1e-12 * b.abs().max(1e-3), "{k:?}: {a} vs {b}");
+                    // The share's change is of the pair's whole value.
+                    let scale = if tol > 1e-12 { want.abs() } else { b.abs() };
+                    assert!((a - b).abs() <= tol * scale.max(1e-3), "{k:?}: {a} vs {b}");
                 }
                 n += 1;
             }
         }
     }
     assert_eq!(n, 80);
+    eprintln!("grey against the RGB sheet's channel 0 in grazing reflection: {worst_grazing:.1e}");
     assert!(g.memory_bytes() < c.memory_bytes());
 }
 

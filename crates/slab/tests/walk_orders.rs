@@ -37,17 +37,18 @@ fn peak_values(b: &SlabBsdf) -> Vec<(String, f64)> {
 /// orders with Fejer's weights (before 2026-12-05: luster 4.6-6.2% under it
 /// lit from the front, 1.1-1.2% from the back). Measured: at most 0.001%
 /// at 60 and 75 degrees. At 85 R -85 the walk's peak is narrower than 256
-/// orders resolve at the node pairs beyond 85 degrees, which keep Fejer's
-/// weights (src/bsdf.rs, `negative_mass`): 2.2% under (4.9% before).
+/// orders resolve at the node pairs beyond 82 degrees, which take part of
+/// Fejer's weights (src/bsdf.rs, `FEJER_SHARE_STEPS`): 1.2% under (2.2%
+/// with Fejer's whole, until 2026-12-06; 4.9% before the walk's orders).
 /// Luster with smoother fronts, Beckmann 0.1 and 0.08 (devB's), and GGX
 /// 0.06, whose walks take more orders than asked
 /// (`interface::walk_orders_for`: 384, 512 and 640): with 256 for every
 /// face the first two were 3.9% and 2.8% off at 80 R -80 on devB's sheet,
-/// now within 0.001% everywhere but 85 R -85 lit from the front, 3.4%,
-/// 3.5% and 2.4% under: the same pairs beyond 85 degrees with Fejer's
-/// weights, whose kernel (about `2 pi / M` wide) takes more off a narrower
-/// peak. 85 R -85 is asserted within 4%, outside the range
-/// (examples/convergence.rs stops at 80 degrees). Lit from the back
+/// now within 0.001% everywhere but 85 R -85 lit from the front, 2.0%,
+/// 2.0% and 0.4% under (3.4%, 3.5% and 2.4% with Fejer's whole): the same
+/// pairs, whose share of Fejer's kernel (about `2 pi / M` wide) takes more
+/// off a narrower peak. 85 R -85 is asserted within 2.5%, outside the
+/// issue's range (examples/convergence.rs stops at 80 degrees). Lit from the back
 /// (luster's Beckmann 0.3 back face, 256 orders) the light meets the
 /// smoother front's walk only after the sheet.
 #[test]
@@ -86,7 +87,7 @@ fn the_walks_forward_peak_converges_in_the_orders() {
                 100.0 * rel,
                 100.0 * rel_old
             );
-            let bound = if at.contains(" 85 R ") { 4e-2 } else { 2e-3 };
+            let bound = if at.contains(" 85 R ") { 2.5e-2 } else { 2e-3 };
             assert!(rel.abs() < bound, "{name} {at}: {v} against {f} with twice the orders");
             assert!(
                 rel.abs() <= rel_old.abs() + 1e-4,
@@ -191,4 +192,41 @@ fn each_face_takes_orders_as_its_roughness_needs() {
         assert!(b >= 2 * a - 64 && b <= 2 * a, "alpha {alpha}: {a} then {b}");
         assert!(a % 64 == 0 && a >= 256, "alpha {alpha}: {a}");
     }
+}
+
+/// Along the walk's mirror ridge at grazing incidence (luster, in the plane
+/// from 79.5 to 84 degrees, where its node pairs begin to ring), 32 and 64
+/// nodes agree within 0.5% (measured 0.29%). The pairs that ring take the
+/// least share of Fejer's weights that keeps them within tolerance
+/// (src/bsdf.rs, `FEJER_SHARE_STEPS`); until 2026-12-06 they took Fejer's
+/// whole, so the ridge stepped down where the first pair rang (82 degrees
+/// on 32 nodes, 80.8 on 64, whose ridge dipped by 8% there) and the two
+/// grids were 1.71% apart at 80.75 degrees.
+#[test]
+fn the_walks_ridge_converges_in_the_nodes() {
+    let p = preset("luster").unwrap();
+    let base = SlabOptions::default();
+    let coarse = SlabBsdf::with_options(&p, &base).unwrap();
+    let fine = SlabBsdf::with_options(
+        &p,
+        &SlabOptions {
+            nodes: 2 * base.nodes,
+            tir_nodes: 2 * base.tir_nodes,
+            ..base
+        },
+    )
+    .unwrap();
+    let mut worst = 0.0f64;
+    for k in 0..=18 {
+        let t = 79.5 + 0.25 * k as f64;
+        let (wi, wo) = in_plane_directions(t, -t, false);
+        let (a, b) = (coarse.eval(wi, wo).mean(), fine.eval(wi, wo).mean());
+        let e = (a / b - 1.0).abs();
+        worst = worst.max(e);
+        assert!(e < 5e-3, "{t} R -{t}: {a} with 32 nodes, {b} with 64");
+    }
+    eprintln!(
+        "luster's ridge 79.5-84 degrees: 32 against 64 nodes within {:.2}%",
+        100.0 * worst
+    );
 }
