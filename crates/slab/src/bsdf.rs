@@ -2630,6 +2630,9 @@ impl SlabBsdf {
             let share = |o: usize, j: usize| -> f64 {
                 let p = o * n + j;
                 let mean = table[side][0][p * m_solved];
+                // The walk's orders past the flat part bound how far the
+                // flat window's sum is from the (non-negative) whole series,
+                // and so its negative part: most pairs end here.
                 let beyond: f64 = walk_r[flat + 1..].iter().map(|w| w[(o, j)].abs()).sum::<f64>() * scale_r(o, j);
                 if (0..ks).all(|k| beyond <= RING_TOLERANCE * mean.0[k].abs()) {
                     return 0.0;
