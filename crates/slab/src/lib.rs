@@ -60,14 +60,18 @@
 //! front's round trip through its coating (glossy 3.3% -> 0.01%, devB
 //! near the normal 10.4% -> 0.03%) and an uncoated sheet's unscattered
 //! transmission through two rough faces (thin tissue 9.6% -> 1.5%, weak
-//! scatter 4.5% -> 0.9%) ([`two_crossings`]). Still missing: a thin
-//! sheet's scattered transmission near the normal, interpolated linearly
-//! in `mu` across a lobe a few intervals wide (the 1.5% and 0.9%); the
+//! scatter 4.5% -> 0.9%) ([`two_crossings`]); near the normal the odd
+//! Fourier orders follow `sin theta` between the nodes (later that day,
+//! [`bsdf`]'s module doc: thin tissue 5-15 degrees from the normal 1.48%
+//! -> 0.50%). Still missing: a higher-order interpolation in `mu` (a thin
+//! sheet's scattered transmission is convex along its straight-through
+//! diagonal: thin tissue 1.10%, weak scatter 0.56%; devB's and luster's
+//! walk ridge at grazing angles 0.99% and 0.78%); the
 //! walk's forward reflection at grazing incidence on a smooth face beyond
 //! 85 degrees (summed to its own 256 orders since 2026-12-05,
 //! [`interface`]: at 75 degrees within 0.001% of twice the orders, 4.6-6.2%
-//! before; at 85 R -85 luster 2.2%, where the pairs beyond 85 degrees keep
-//! Fejer's weights); exact single scattering as its own term (the tables
+//! before; at 85 R -85 luster 1.2%, where the pairs beyond 82 degrees take
+//! part of Fejer's weights); exact single scattering as its own term (the tables
 //! hold every scattering order, so `slab` has no separate `single`
 //! component); the flank of the walk's forward peak
 //! at grazing angles off a Beckmann 0.15 face, interpolated linearly in

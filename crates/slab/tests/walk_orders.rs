@@ -12,6 +12,8 @@ use paperbsdf_core::presets::preset;
 use paperbsdf_core::{Bsdf, DVec3, Distribution, PaperParams};
 use paperbsdf_slab::{SlabBsdf, SlabOptions};
 
+mod support;
+
 /// In-plane reflection at the walk's forward peak, lit from the front and
 /// (the same directions mirrored through the sheet) from the back.
 fn peak_values(b: &SlabBsdf) -> Vec<(String, f64)> {
@@ -204,18 +206,7 @@ fn each_face_takes_orders_as_its_roughness_needs() {
 /// grids were 1.71% apart at 80.75 degrees.
 #[test]
 fn the_walks_ridge_converges_in_the_nodes() {
-    let p = preset("luster").unwrap();
-    let base = SlabOptions::default();
-    let coarse = SlabBsdf::with_options(&p, &base).unwrap();
-    let fine = SlabBsdf::with_options(
-        &p,
-        &SlabOptions {
-            nodes: 2 * base.nodes,
-            tir_nodes: 2 * base.tir_nodes,
-            ..base
-        },
-    )
-    .unwrap();
+    let (coarse, fine) = support::default_and_doubled_nodes(&preset("luster").unwrap());
     let mut worst = 0.0f64;
     for k in 0..=18 {
         let t = 79.5 + 0.25 * k as f64;
