@@ -64,9 +64,12 @@
 //! Fourier orders follow `sin theta` between the nodes (later that day,
 //! [`bsdf`]'s module doc: thin tissue 5-15 degrees from the normal 1.48%
 //! -> 0.50%). Still missing: a higher-order interpolation in `mu` (a thin
-//! sheet's scattered transmission is convex along its straight-through
-//! diagonal: thin tissue 1.10%, weak scatter 0.56%; devB's and luster's
-//! walk ridge at grazing angles 0.99% and 0.78%); the
+//! sheet's scattered transmission on the far flank of its forward lobe,
+//! `mu_o = mu_i` with the viewer on the light's side, where the lobe's
+//! width in azimuth changes with `theta` between the nodes: thin tissue
+//! 1.10%, weak scatter 0.56%, falling as the square of the node spacing,
+//! 0.28% and 0.14% from 64 nodes, README "Convergence"; devB's and
+//! luster's walk ridge at grazing angles 0.99% and 0.78%); the
 //! walk's forward reflection at grazing incidence on a smooth face beyond
 //! 85 degrees (summed to its own 256 orders since 2026-12-05,
 //! [`interface`]: at 75 degrees within 0.001% of twice the orders, 4.6-6.2%
