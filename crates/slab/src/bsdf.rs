@@ -2942,25 +2942,25 @@ impl SlabBsdf {
     }
 
     /// The table's sum over the triangle's `corners` (offsets from the
-    /// intervals of `(wi, wo)`) with `weights`, where a direction is in the
-    /// odd orders' band: even orders with `weights`, odd ones with
-    /// `weights` times each corner's ratio (its share of it,
-    /// [`Tables::odd_share`]), as the series at `phi` and at `pi - phi` (odd
-    /// orders change sign) mixed. Not inlined: most directions are outside
-    /// the band, and `eval`'s common path stays as it was before the band.
+    /// intervals of `(wi, wo)`; `pairs` their node pairs) with `weights`,
+    /// where a direction is in the odd orders' band: even orders with
+    /// `weights`, odd ones with `weights` times each corner's ratio (its
+    /// share of it, [`Tables::odd_share`]), as the series at `phi` and at
+    /// `pi - phi` (odd orders change sign) mixed. A function of its own so
+    /// that `eval`'s common path, outside the band, stays as it was before
+    /// the band (`#[inline(never)]` and `#[cold]` made the band's own
+    /// `eval` slower in criterion, 2026-12-06).
     #[inline]
     fn odd_band_sum(
         &self,
         tab: &Tables,
         st: usize,
         (wi, wo): (Place, Place),
-        corners: [(usize, usize); 3],
+        (corners, pairs): ([(usize, usize); 3], [usize; 3]),
         weights: [f64; 3],
         c: f64,
     ) -> Rgb {
-        let n = self.mu.len();
         let (j, o) = (wi.at.0, wo.at.0);
-        let pairs = corners.map(|(a, b)| (o + a) * n + j + b);
         let rho = corners.map(|(a, b)| self.odd_ratio(wo, o + a) * self.odd_ratio(wi, j + b));
         let odd: [f64; 3] = std::array::from_fn(|k| 1.0 + tab.odd_share(st, pairs[k]) * (rho[k] - 1.0));
         let same: [f64; 3] = std::array::from_fn(|k| weights[k] * 0.5 * (1.0 + odd[k]));
@@ -2998,7 +2998,7 @@ impl SlabBsdf {
                 1 => Rgb::splat(fourier_sum::<1>(tab, st, pairs, weights, c)[0]),
                 _ => Rgb(fourier_sum::<3>(tab, st, pairs, weights, c)),
             },
-            None => self.odd_band_sum(tab, st, (wi, wo), corners, weights, c),
+            None => self.odd_band_sum(tab, st, (wi, wo), (corners, pairs), weights, c),
             Some(pole) => match tab.channels {
                 1 => Rgb::splat(fourier_sum_pole::<1>(tab, st, pairs, weights, &pole, c)[0]),
                 _ => Rgb(fourier_sum_pole::<3>(tab, st, pairs, weights, &pole, c)),
