@@ -19,8 +19,11 @@
 //! change (the far tails of a narrow lobe, where a relative change says
 //! nothing a renderer sees).
 //!
-//! `cargo run --release -p paperbsdf-slab --example convergence [CASE...]`
-//! (optional case names, e.g. `thin-tissue devB`: only those cases).
+//! `cargo run --release -p paperbsdf-slab --example convergence [--nodes N] [CASE...]`
+//! (optional case names, e.g. `thin-tissue devB`: only those cases;
+//! `--nodes N`: `N` nodes and `N / 2` in the cone instead of the default's
+//! 32 and 16, against twice as many, for how the change falls with the
+//! nodes; the base build's time is printed).
 
 use paperbsdf_core::bsdf::albedo_from;
 use paperbsdf_core::geometry::in_plane_directions;
@@ -80,12 +83,24 @@ fn albedos(b: &SlabBsdf) -> Vec<f64> {
 }
 
 fn main() {
-    let only: Vec<String> = std::env::args().skip(1).collect();
+    let mut only: Vec<String> = std::env::args().skip(1).collect();
+    let mut base = SlabOptions::default();
+    if let Some(k) = only.iter().position(|a| a == "--nodes") {
+        let n: usize = match only.get(k + 1).map(|v| v.parse()) {
+            Some(Ok(n)) if n >= 4 => n,
+            _ => {
+                eprintln!("--nodes needs a whole number of nodes, at least 4");
+                std::process::exit(2);
+            }
+        };
+        base.nodes = n;
+        base.tir_nodes = n / 2;
+        only.drain(k..k + 2);
+    }
     let cases: Vec<_> = cases::cases()
         .into_iter()
         .filter(|(n, _)| only.is_empty() || only.contains(n))
         .collect();
-    let base = SlabOptions::default();
     let variants = [
         (
             "nodes x2",
@@ -110,7 +125,14 @@ fn main() {
                 face_scattering: faces,
                 ..p.clone()
             };
+            let t0 = std::time::Instant::now();
             let b0 = SlabBsdf::with_options(&p, &base).expect("build");
+            println!(
+                "{:8} {name:14} {} nodes: build {:.2} s",
+                faces.name(),
+                base.nodes,
+                t0.elapsed().as_secs_f64()
+            );
             let (v0, at) = in_plane(&b0);
             let a0 = albedos(&b0);
             let floor = 1e-3 * v0.iter().cloned().fold(0.0, f64::max);
