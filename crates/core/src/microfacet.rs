@@ -301,24 +301,16 @@ impl Microfacet {
     /// the horizon (below, the visible part of the stretched hemisphere
     /// projects to a half-disk minus a half-ellipse); the micro-normal has `z > 0`.
     pub(crate) fn sample_visible_ggx(&self, w: DVec3, u: [f64; 2]) -> DVec3 {
-        // Heitz 2018: stretch, sample a projected disk, unstretch.
-        let a = self.alpha;
-        let vh = DVec3::new(a * w.x, a * w.y, w.z).normalize();
-        let lensq = vh.x * vh.x + vh.y * vh.y;
-        let t1 = if lensq > 0.0 {
-            DVec3::new(-vh.y, vh.x, 0.0) / lensq.sqrt()
-        } else {
-            DVec3::X
-        };
-        let t2 = vh.cross(t1);
-        let r = u[0].sqrt();
-        let (sin_phi, cos_phi) = crate::geometry::sin_cos_2pi(u[1]);
-        let p1 = r * cos_phi;
-        let s = 0.5 * (1.0 + vh.z);
-        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sin_phi;
-        let p3 = (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
-        let nh = p1 * t1 + p2 * t2 + p3 * vh;
-        DVec3::new(a * nh.x, a * nh.y, nh.z.max(1e-12)).normalize()
+        GgxVisibleFrame::new(self.alpha, w).normal(u[0].sqrt(), crate::geometry::sin_cos_2pi(u[1]))
+    }
+
+    /// For quadrature over the visible normals of a GGX surface seen from
+    /// `w` (flipped to the upper hemisphere if below): the stretched frame
+    /// of [`Microfacet::sample_visible`] made once, so that a tensor grid
+    /// of `(u0, u1)` needs one square root per row and one sine and cosine
+    /// per column ([`GgxVisibleFrame::normal`]).
+    pub fn ggx_visible_frame(&self, w: DVec3) -> GgxVisibleFrame {
+        GgxVisibleFrame::new(self.alpha, if w.z < 0.0 { -w } else { w })
     }
 
     fn sample_visible_beckmann(&self, w: DVec3, u: [f64; 2]) -> DVec3 {
@@ -351,6 +343,54 @@ fn beckmann_lambda_a(a: f64) -> f64 {
         return 0.0;
     }
     0.5 * (libm::erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * PI.sqrt())
+}
+
+/// The stretched frame of GGX visible-normal sampling for one direction
+/// (Heitz 2018: stretch the direction, sample a projected disk, unstretch),
+/// [`Microfacet::ggx_visible_frame`]: valid for a direction above or below
+/// the horizon (below, the visible part of the stretched hemisphere
+/// projects to a half-disk minus a half-ellipse).
+#[derive(Clone, Copy, Debug)]
+pub struct GgxVisibleFrame {
+    alpha: f64,
+    /// The stretched direction (unit).
+    vh: DVec3,
+    /// The disk's axes: `t1` across the stretched plane of incidence, `t2`.
+    t1: DVec3,
+    t2: DVec3,
+    /// `(1 + vh.z) / 2`, the share of the disk's second half that is visible.
+    s: f64,
+}
+
+impl GgxVisibleFrame {
+    fn new(alpha: f64, w: DVec3) -> GgxVisibleFrame {
+        let vh = DVec3::new(alpha * w.x, alpha * w.y, w.z).normalize();
+        let lensq = vh.x * vh.x + vh.y * vh.y;
+        let t1 = if lensq > 0.0 {
+            DVec3::new(-vh.y, vh.x, 0.0) / lensq.sqrt()
+        } else {
+            DVec3::X
+        };
+        GgxVisibleFrame {
+            alpha,
+            vh,
+            t1,
+            t2: vh.cross(t1),
+            s: 0.5 * (1.0 + vh.z),
+        }
+    }
+
+    /// The micro-normal (`z > 0`) at the disk's point of radius `r =
+    /// sqrt(u0)` and angle `2 pi u1` given by its `(sin, cos)`: what
+    /// [`Microfacet::sample_visible`] returns for `(u0, u1)`.
+    #[inline]
+    pub fn normal(&self, r: f64, (sin_phi, cos_phi): (f64, f64)) -> DVec3 {
+        let p1 = r * cos_phi;
+        let p2 = (1.0 - self.s) * (1.0 - p1 * p1).max(0.0).sqrt() + self.s * r * sin_phi;
+        let p3 = (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
+        let nh = p1 * self.t1 + p2 * self.t2 + p3 * self.vh;
+        DVec3::new(self.alpha * nh.x, self.alpha * nh.y, nh.z.max(1e-12)).normalize()
+    }
 }
 
 /// The stretched frame of Beckmann visible-normal sampling for one direction

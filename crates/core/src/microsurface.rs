@@ -506,6 +506,19 @@ pub struct Scatterer {
 }
 
 impl Scatterer {
+    /// The normalisation of the arriving ray's visible normals, `int max(0,
+    /// i.m) D(m) dm` (0 when nothing is visible): `density(o) * norm` is
+    /// `D F / 4` in reflection, symmetric in the two directions, which is
+    /// how a discrete solver of the walk gets the reverse paths' kernel by
+    /// reciprocity.
+    pub fn norm(&self) -> f64 {
+        if self.inv_norm > 0.0 {
+            1.0 / self.inv_norm
+        } else {
+            0.0
+        }
+    }
+
     /// [`Microsurface::scatter_density`] of the new direction `o` (same
     /// local frame), by reflection or by refraction as `reflected` says.
     /// Always inlined: `paperbsdf_slab::face_walk` calls it from two loops

@@ -94,7 +94,10 @@
 //! twice the nodes, 0.07-0.22% now). Builds
 //! take 0.71 to 0.92 s for the presets (the coated glossy sheet the
 //! slowest; the dense solves' triangular substitutions are blocked,
-//! `linalg`, which made up for the edges' 35 ms per face). `eval` at grazing
+//! `linalg`, which made up for the edges' 35 ms per face); on the slower
+//! machine of 2026-12-06 1.00 s at most, the worst case the RGB thin sheet
+//! with unequal faces and glossy (README "Speed": reciprocity halves the
+//! faces' evaluations, [`interface`], [`face_walk`]). `eval` at grazing
 //! angles near the mirror direction, where node pairs keep up to 256
 //! orders (the walk's forward peak), takes 125-152 ns with AVX2 and FMA
 //! (benches/slab.rs `eval_grazing`, 2026-12-05 evening: those pairs'

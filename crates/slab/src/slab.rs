@@ -306,11 +306,18 @@ impl SlabSpec {
             };
             face_interface(&bd, fs, &outside, below, &proj)
         };
-        let front = project(&self.front, "_f", coat_grid.as_ref().unwrap_or(&inside))?;
-        let back = if self.back == self.front {
-            front.clone()
+        // Two different faces are projected at the same time: each
+        // projection's serial steps (the normalisation's scaling, the
+        // orders' assembly) leave a core idle that the other fills.
+        let (front, back) = if self.back == self.front {
+            let front = project(&self.front, "_f", coat_grid.as_ref().unwrap_or(&inside))?;
+            (front.clone(), front)
         } else {
-            project(&self.back, "_b", &inside)?
+            let (front, back) = rayon::join(
+                || project(&self.front, "_f", coat_grid.as_ref().unwrap_or(&inside)),
+                || project(&self.back, "_b", &inside),
+            );
+            (front?, back?)
         };
         let coating = match coat_grid {
             None => None,
