@@ -50,8 +50,8 @@ fn bench(c: &mut Criterion) {
             })
         });
         // Both directions 5-20 degrees from the normal, off the nodes: the
-        // odd orders take their ratio there (`ODD_ORDER_BAND`), two series
-        // per corner instead of one.
+        // orders follow the sine law there (`SIN_LAW_BAND`), each corner
+        // against its own `rho^m cos(m phi)` instead of the shared cosines.
         let dn = (
             DVec3::new(-0.12, 0.05, -0.99).normalize(),
             DVec3::new(0.2, 0.1, 0.97).normalize(),

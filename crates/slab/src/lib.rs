@@ -63,12 +63,14 @@
 //! scatter 4.5% -> 0.9%) ([`two_crossings`]); near the normal the odd
 //! Fourier orders follow `sin theta` between the nodes (later that day,
 //! [`bsdf`]'s module doc: thin tissue 5-15 degrees from the normal 1.48%
-//! -> 0.50%). Still missing: a higher-order interpolation in `mu` (a thin
-//! sheet's scattered transmission on the far flank of its forward lobe,
-//! `mu_o = mu_i` with the viewer on the light's side, where the lobe's
-//! width in azimuth changes with `theta` between the nodes: thin tissue
-//! 1.10%, weak scatter 0.56%, falling as the square of the node spacing,
-//! 0.28% and 0.14% from 64 nodes, README "Convergence"; devB's and
+//! -> 0.50%), and since that evening every order within 45 degrees of it
+//! follows `sin^m theta` ([`bsdf::SIN_LAW_BAND`]: a thin sheet's
+//! scattered transmission on the far flank of its forward lobe, `mu_o =
+//! mu_i` with the viewer on the light's side, thin tissue 1.10% -> 0.34%
+//! with twice the nodes, weak scatter 0.56% -> 0.45%, README
+//! "Convergence"). Still missing: convergence below 0.2% with twice the
+//! nodes on the thin sheets (thin tissue 0.34%, weak scatter 0.45%, its
+//! straight-through direction at 30 degrees) and at grazing angles (devB's and
 //! luster's walk ridge at grazing angles 0.99% and 0.78%); the
 //! walk's forward reflection at grazing incidence on a smooth face beyond
 //! 85 degrees (summed to its own 256 orders since 2026-12-05,
