@@ -692,9 +692,13 @@ impl Tables {
 }
 
 /// Bisection steps of a pair's share of the sine law's ratio where the
-/// whole ratio would send its series below zero (`Tables::limit_law`): a
-/// share within 1/64 below the largest that keeps it non-negative.
-const LAW_SHARE_STEPS: usize = 6;
+/// whole ratio would send its series below zero (`Tables::limit_law`): 40,
+/// so that the share is a continuous function of the sheet's parameters
+/// (to 1e-12), as a fit needs. With 6 steps (shares within 1/64) `eval`
+/// was a step function of them, and the slab refinement of
+/// crates/fit/tests/slab_refine.rs stopped at `m_b` 1.6e-3 from the data's
+/// (asserted 1e-3); with 40 it passes.
+const LAW_SHARE_STEPS: usize = 40;
 
 /// Azimuth samples per order of a series ([`SeriesSamples`]): 8, so that the
 /// quintic's error on the highest order, a phase step of `pi / 8` a
