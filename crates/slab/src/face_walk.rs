@@ -311,6 +311,7 @@ fn kernel_values(s: &Microsurface, st: &[State], phis: &[(f64, f64)], reciprocal
         .map(|a| {
             let sa = &st[a];
             let mut vals = direct[a].clone();
+            let na = scatterers[a].norm();
             for b_idx in 0..n {
                 if evaluated(a, b_idx) {
                     continue;
@@ -318,7 +319,6 @@ fn kernel_values(s: &Microsurface, st: &[State], phis: &[(f64, f64)], reciprocal
                 let (Some(rb), Some(ra)) = (rev[b_idx], rev[a]) else {
                     continue;
                 };
-                let na = scatterers[a].norm();
                 let factor = if na > 0.0 {
                     let crossing = if sa.outside == st[b_idx].outside {
                         1.0

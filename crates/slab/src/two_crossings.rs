@@ -101,10 +101,9 @@
 
 use paperbsdf_core::dielectric::Interface;
 use paperbsdf_core::fresnel::fresnel_dielectric;
-use paperbsdf_core::geometry::{refract, sin_cos_2pi};
-use paperbsdf_core::microfacet::beckmann_slope_y;
+use paperbsdf_core::geometry::refract;
 use paperbsdf_core::quadrature::gauss_legendre_01;
-use paperbsdf_core::{DVec3, Distribution, Microfacet, RoughDielectric};
+use paperbsdf_core::{DVec3, Microfacet, RoughDielectric};
 use rayon::prelude::*;
 
 /// Points of the table along `x` (the half vector's slope), `sqrt(cos
@@ -874,7 +873,7 @@ impl TwoCrossings {
             Some((f_in * f_out / (eta2 * eta2 * -v.z), p1, p2))
         };
         // Both samplers' micro-normals on the rule's points.
-        let (n1, n2) = (visible_normals(&m1, wi, u), visible_normals(&m2, wo, u));
+        let (n1, n2) = (m1.visible_normal_grid(wi, u), m2.visible_normal_grid(wo, u));
         for (a, wa) in w.iter().enumerate() {
             for (b, wb) in w.iter().enumerate() {
                 let k = a * u.len() + b;
@@ -967,36 +966,6 @@ fn crossing(mf: &Microfacet, eta: f64, out: &Outside, v: DVec3) -> Option<(f64, 
     let p = out.g1_exact * lens;
     let f = (1.0 - fresnel_dielectric(wh, eta)) * (out.g1 * mf.g1(v, h)) * lens;
     Some((p, f))
-}
-
-/// The micro-normals of `mf` visible from `w` (above the face) at the
-/// product of the points `u` in the sampler's unit square (`u[a]` first,
-/// `u[b]` second, at `a * len + b`): core's GGX sampler, and for Beckmann
-/// the separable visible slopes (one inversion per row and per column;
-/// the exact inverse error function across the incidence plane, so that
-/// the points' density is the visible normals' exactly).
-fn visible_normals(mf: &Microfacet, w: DVec3, u: &[f64]) -> Vec<DVec3> {
-    match mf.dist {
-        Distribution::Beckmann => {
-            let frame = mf.beckmann_visible_frame(w);
-            let xs: Vec<f64> = u.iter().map(|&x| frame.slope_x(x)).collect();
-            let ys: Vec<f64> = u.iter().map(|&y| beckmann_slope_y(y)).collect();
-            xs.iter()
-                .flat_map(|&x| ys.iter().map(move |&y| frame.normal(x, y)))
-                .collect()
-        }
-        Distribution::Ggx => {
-            // The sampler's disk radius per row and angle per column.
-            let frame = mf.ggx_visible_frame(w);
-            let angles: Vec<(f64, f64)> = u.iter().map(|&b| sin_cos_2pi(b)).collect();
-            u.iter()
-                .flat_map(|&a| {
-                    let r = a.sqrt();
-                    angles.iter().map(move |&ang| frame.normal(r, ang))
-                })
-                .collect()
-        }
-    }
 }
 
 /// How far a rough face turns a direction it refracts, in half-vector

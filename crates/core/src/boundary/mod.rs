@@ -15,8 +15,7 @@ pub mod tables;
 
 use crate::dielectric::{Interface, RoughDielectric};
 use crate::fresnel::fresnel_dielectric;
-use crate::geometry::{reflect, refract, sin_cos_2pi};
-use crate::microfacet::{beckmann_slope_y, BeckmannVisibleFrame, Distribution, GgxVisibleFrame};
+use crate::geometry::{reflect, refract};
 use crate::quadrature::gauss_legendre_01;
 use glam::DVec3;
 
@@ -46,33 +45,13 @@ pub fn directional_albedo_n(b: &RoughDielectric, w: DVec3, n: usize) -> (f64, f6
     }
     let eta_ti = if w.z > 0.0 { 1.0 / b.eta } else { b.eta };
     let (x, wt) = gauss_legendre_01(n);
-    // Both visible-normal maps are separable on a tensor grid: Beckmann's
-    // slopes inverted once per row and column, GGX's disk radius once per
-    // row and its angle once per column (the samplers' values exactly).
-    enum Rows {
-        Beckmann(BeckmannVisibleFrame, Vec<f64>, Vec<f64>),
-        Ggx(GgxVisibleFrame, Vec<f64>, Vec<(f64, f64)>),
-    }
-    let rows = match mf.dist {
-        Distribution::Beckmann => {
-            let fr = mf.beckmann_visible_frame(w);
-            let sx: Vec<f64> = x.iter().map(|&u| fr.slope_x(u)).collect();
-            let sy: Vec<f64> = x.iter().map(|&u| beckmann_slope_y(u)).collect();
-            Rows::Beckmann(fr, sx, sy)
-        }
-        Distribution::Ggx => Rows::Ggx(
-            mf.ggx_visible_frame(w),
-            x.iter().map(|u| u.sqrt()).collect(),
-            x.iter().map(|&u| sin_cos_2pi(u)).collect(),
-        ),
-    };
+    // Both visible-normal maps are separable on a tensor grid (one
+    // inversion per row and per column; the samplers' values).
+    let normals = mf.visible_normal_grid(w, &x);
     let (mut r, mut t) = (0.0, 0.0);
     for i in 0..x.len() {
         for j in 0..x.len() {
-            let h = match &rows {
-                Rows::Beckmann(fr, sx, sy) => fr.normal(sx[i], sy[j]),
-                Rows::Ggx(fr, radius, angle) => fr.normal(radius[i], angle[j]),
-            };
+            let h = normals[i * x.len() + j];
             let wh = w.dot(h);
             if wh * w.z <= 0.0 {
                 continue;
