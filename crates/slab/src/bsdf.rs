@@ -696,13 +696,15 @@ impl Tables {
 }
 
 /// Bisection steps of a pair's share of the sine law's ratio where the
-/// whole ratio would make `eval`'s clamp add more than [`RING_TOLERANCE`]
-/// (`Tables::limit_law`): 40, so that the share is a continuous function
-/// of the sheet's parameters (to 1e-12), as a fit needs. With 6 (shares
-/// within 1/64) `eval` was a step function of them, and the slab
-/// refinement of crates/fit/tests/slab_refine.rs stopped at `m_b` 1.6e-3
-/// from the data's (asserted 1e-3); with 40 it passes.
-const LAW_SHARE_STEPS: usize = 40;
+/// whole ratio would make `eval`'s clamp add more than
+/// [`LAW_RING_TOLERANCE`] (`Tables::limit_law`): 24, the share to `2^-24`,
+/// the precision of the `f32` it is stored in, so that it is a continuous
+/// function of the sheet's parameters to that, as a fit needs
+/// (`law_shares_are_continuous`). With 6 (shares within 1/64) `eval` was
+/// a step function of them, and the slab refinement of
+/// crates/fit/tests/slab_refine.rs stopped at `m_b` 1.6e-3 from the data's
+/// (asserted 1e-3); 40, to 1e-12, cost 60% more for digits `f32` drops.
+const LAW_SHARE_STEPS: usize = 24;
 
 /// Azimuths per order (at least 8 orders) at which `Tables::limit_law`
 /// integrates a pair's negative part ([`negative_mean`]): 4, twice
