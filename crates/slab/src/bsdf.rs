@@ -660,16 +660,7 @@ impl Tables {
                     if within(1.0) {
                         return 1.0;
                     }
-                    let (mut lo, mut hi) = (0.0, 1.0);
-                    for _ in 0..LAW_SHARE_STEPS {
-                        let mid = 0.5 * (lo + hi);
-                        if within(mid) {
-                            lo = mid;
-                        } else {
-                            hi = mid;
-                        }
-                    }
-                    lo as f32
+                    bisect_unit(LAW_SHARE_STEPS, within).0 as f32
                 })
                 .collect();
         }
@@ -1654,6 +1645,24 @@ fn cos_phi(wi: DVec3, wo: DVec3) -> f64 {
         -(wi.x * wo.x + wi.y * wo.y) / (si * so)
     };
     c.clamp(-1.0, 1.0)
+}
+
+/// The bracket `(lo, hi)` around the boundary in `[0, 1]` of a predicate
+/// true below it and false above (a monotone one), after `steps` halvings:
+/// the sine law's shares (`Tables::limit_law`, the largest share within
+/// its tolerance: `lo`) and Fejer's (`fejer_where_ringing`, the least that
+/// stops the ringing: `hi`).
+fn bisect_unit(steps: usize, below: impl Fn(f64) -> bool) -> (f64, f64) {
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..steps {
+        let mid = 0.5 * (lo + hi);
+        if below(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    (lo, hi)
 }
 
 /// The mean over azimuth of the negative part of a node pair's series
@@ -2967,16 +2976,7 @@ impl SlabBsdf {
                 if !rings_at(0.0) {
                     return 0.0;
                 }
-                let (mut lo, mut hi) = (0.0, 1.0);
-                for _ in 0..FEJER_SHARE_STEPS {
-                    let mid = 0.5 * (lo + hi);
-                    if rings_at(mid) {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                hi
+                bisect_unit(FEJER_SHARE_STEPS, rings_at).1
             };
             let fallback: Vec<(usize, usize, f64)> = (0..n * n)
                 .into_par_iter()
