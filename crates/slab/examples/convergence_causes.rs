@@ -14,13 +14,19 @@
 //!   grid of examples/convergence.rs, 32 against 64 nodes: the largest
 //!   change of the value, and of the value without the unscattered part
 //!   (component `direct`), relative to the value: what an exact unscattered
-//!   term would leave (2026-12-06: 10.6% and 1.1%, 4.7% and 0.7%).
+//!   term would leave (2026-12-06: 10.6% and 1.1%, 4.7% and 0.7%);
+//! - near grazing reflection with multiple-scattering faces (README, "luster
+//!   and devB at 80 degrees"): devB on the mirror diagonal from 60 to 85
+//!   degrees, luster lit at 71 and matte at 62 (between nodes) seen from
+//!   -60 to -80: the whole value and the table's part (`eval` less the lit
+//!   face's first reflection, component `surface`), 32 and 64 nodes
+//!   against 128.
 //!
 //! `cargo run --release -p paperbsdf-slab --example convergence_causes`
 
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::models::{Component, ComponentModel};
-use paperbsdf_core::{Bsdf, PaperParams};
+use paperbsdf_core::{Bsdf, FaceScattering, PaperParams};
 use paperbsdf_slab::{SlabBsdf, SlabOptions};
 
 // The cases of docs/accuracy.md, as the accuracy example has them.
@@ -52,6 +58,49 @@ fn row(p: &PaperParams, points: &[(f64, f64, bool)]) {
             v[2],
             100.0 * (v[0] / v[1] - 1.0),
             100.0 * (v[1] / v[2] - 1.0)
+        );
+    }
+}
+
+/// Reflection (multiple-scattering faces) at `(theta_i, theta_o)`: the
+/// whole value on 32, 64 and 128 nodes, and the changes of the whole and
+/// of the table's part (`eval` less component `surface`, the lit face's
+/// first reflection, which is analytic) from 32 and 64 nodes to 128.
+fn table_part(p: &PaperParams, points: &[(f64, f64)]) {
+    let p = PaperParams {
+        face_scattering: FaceScattering::Multiple,
+        ..p.clone()
+    };
+    let base = SlabOptions::default();
+    let bsdfs: Vec<SlabBsdf> = [1, 2, 4]
+        .iter()
+        .map(|&k| {
+            let o = SlabOptions {
+                nodes: k * base.nodes,
+                tir_nodes: k * base.tir_nodes,
+                ..base
+            };
+            SlabBsdf::with_options(&p, &o).expect("build")
+        })
+        .collect();
+    for &(ti, to) in points {
+        let (wi, wo) = in_plane_directions(ti, to, false);
+        let v: Vec<f64> = bsdfs.iter().map(|b| b.eval(wi, wo).mean()).collect();
+        let t: Vec<f64> = bsdfs
+            .iter()
+            .zip(&v)
+            .map(|(b, v)| v - b.eval_component(wi, wo, Component::Surface).mean())
+            .collect();
+        println!(
+            "  ({ti:.1} R {to:.1}): 32 {:.4}  64 {:.4}  128 {:.4}   whole 32 {:+.2}% 64 {:+.2}%   table {:.4}: 32 {:+.2}% 64 {:+.2}%",
+            v[0],
+            v[1],
+            v[2],
+            100.0 * (v[0] / v[2] - 1.0),
+            100.0 * (v[1] / v[2] - 1.0),
+            t[2],
+            100.0 * (t[0] / t[2] - 1.0),
+            100.0 * (t[1] / t[2] - 1.0)
         );
     }
 }
@@ -133,5 +182,13 @@ fn main() {
     row(&t, &pts);
     for name in ["thin-tissue", "weak-scatter"] {
         scattered_alone(name, &get(name));
+    }
+    println!("devB on the mirror diagonal, multiple-scattering faces (the table's part: the walk's peak):");
+    let pts: Vec<(f64, f64)> = (0..=50).map(|k| 60.0 + 0.5 * k as f64).map(|t| (t, -t)).collect();
+    table_part(&get("devB"), &pts);
+    for (name, ti) in [("preset-luster", 71.0), ("preset-matte", 62.0)] {
+        println!("{name} lit at {ti}, between nodes, multiple-scattering faces:");
+        let pts: Vec<(f64, f64)> = (0..=20).map(|k| (ti, -60.0 - k as f64)).collect();
+        table_part(&get(name), &pts);
     }
 }
