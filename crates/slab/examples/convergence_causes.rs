@@ -20,13 +20,18 @@
 //!   degrees, luster lit at 71 and matte at 62 (between nodes) seen from
 //!   -60 to -80: the whole value and the table's part (`eval` less the lit
 //!   face's first reflection, component `surface`), 32 and 64 nodes
-//!   against 128.
+//!   against 128; and the same points on the face alone: the sheet made
+//!   black and uncoated (`sigma_a` 2000 /mm, `sigma_s` 1e-3 /mm, `eta_b =
+//!   eta_f`), where the table's part is only the lit face's walk (its
+//!   light scattered twice or more on the microsurface and leaving
+//!   outside), to tell the walk's share of the node change from the
+//!   medium's.
 //!
 //! `cargo run --release -p paperbsdf-slab --example convergence_causes`
 
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::models::{Component, ComponentModel};
-use paperbsdf_core::{Bsdf, FaceScattering, PaperParams};
+use paperbsdf_core::{Bsdf, Colour, FaceScattering, PaperParams};
 use paperbsdf_slab::{SlabBsdf, SlabOptions};
 
 // The cases of docs/accuracy.md, as the accuracy example has them.
@@ -183,12 +188,26 @@ fn main() {
     for name in ["thin-tissue", "weak-scatter"] {
         scattered_alone(name, &get(name));
     }
+    // The face alone: no light comes back from a black medium, and
+    // `eta_b = eta_f` removes a coating's boundary.
+    let black = |p: PaperParams| PaperParams {
+        sigma_a: Colour::Scalar(2000.0),
+        sigma_s: Colour::Scalar(1e-3),
+        eta_b: p.eta_f,
+        ..p
+    };
     println!("devB on the mirror diagonal, multiple-scattering faces (the table's part: the walk's peak):");
     let pts: Vec<(f64, f64)> = (0..=50).map(|k| 60.0 + 0.5 * k as f64).map(|t| (t, -t)).collect();
     table_part(&get("devB"), &pts);
+    println!("devB's face alone (black, uncoated) on the mirror diagonal (the table's part: the walk alone):");
+    let pts: Vec<(f64, f64)> = (0..=10).map(|k| 70.0 + 1.5 * k as f64).map(|t| (t, -t)).collect();
+    table_part(&black(get("devB")), &pts);
     for (name, ti) in [("preset-luster", 71.0), ("preset-matte", 62.0)] {
         println!("{name} lit at {ti}, between nodes, multiple-scattering faces:");
         let pts: Vec<(f64, f64)> = (0..=20).map(|k| (ti, -60.0 - k as f64)).collect();
         table_part(&get(name), &pts);
+        println!("{name}'s face alone (black, uncoated) lit at {ti}:");
+        let pts: Vec<(f64, f64)> = (0..=10).map(|k| (ti, -60.0 - 2.0 * k as f64)).collect();
+        table_part(&black(get(name)), &pts);
     }
 }
