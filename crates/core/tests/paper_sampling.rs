@@ -277,3 +277,49 @@ fn face_reflection_and_pdf_at_once() {
     }
     assert!(n > 400, "too few directions with a face reflection: {n}");
 }
+
+/// The interface's reflection of a coated front (glossy: Beckmann 0.04 at
+/// 1.55 over a base of 1.5) is the reflection of the same interface on an
+/// uncoated sheet (`eta_b = eta_f`): Walter's lobe, and for `face_scattering
+/// = "multiple"` the compensation lobe, which depends on the interface
+/// alone; none of the coating's lobe. Both face modes, directions down to
+/// 0.01 degrees above the horizon, with and without the coating's lobe
+/// dominating (near the normal, away from the mirror direction).
+#[test]
+fn coated_interface_reflection_is_the_uncoated_face() {
+    use paperbsdf_core::paper::Side;
+    use paperbsdf_core::presets::preset;
+    use paperbsdf_core::FaceScattering;
+    let mut n = 0;
+    for fs in [FaceScattering::Single, FaceScattering::Multiple] {
+        let coated = PaperParams {
+            face_scattering: fs,
+            ..preset("glossy").unwrap()
+        };
+        let uncoated = PaperParams {
+            eta_b: coated.eta_f,
+            ..coated.clone()
+        };
+        let (c, u) = (PaperBsdf::new(&coated).unwrap(), PaperBsdf::new(&uncoated).unwrap());
+        for k in 0..2000 {
+            let f = |a: f64| (0.5 + k as f64 * a).fract();
+            let max = (90.0f64 - 0.01).to_radians();
+            let (ti, to) = (f(0.618_033_988_7) * max, f(0.754_877_666) * max);
+            let wi = spherical_direction(ti, f(0.569_840_29) * std::f64::consts::TAU);
+            let wo = spherical_direction(to, f(0.412_454_03) * std::f64::consts::TAU);
+            let (a, b) = (
+                c.face_interface_reflection(Side::Front, wi, wo),
+                u.face_interface_reflection(Side::Front, wi, wo),
+            );
+            assert!(
+                (a - b).abs() <= 1e-13 * b.abs(),
+                "{fs:?} at {wi:?} -> {wo:?}: coated {a}, uncoated {b}"
+            );
+            // The coated face's whole reflection holds the coating's lobe too.
+            let whole = c.face_reflection(Side::Front, wi, wo);
+            assert!(whole >= a, "{fs:?}: whole {whole} below the interface's {a}");
+            n += usize::from(b > 0.0 && whole > 1.001 * b);
+        }
+    }
+    assert!(n > 1000, "too few directions where the coating's lobe shows: {n}");
+}
