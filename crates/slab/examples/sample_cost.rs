@@ -1,6 +1,6 @@
 //! Calls `SlabBsdf::sample` (or `eval`, `pdf`) many times for a preset at
 //! directions off the nodes (or `eval_grazing`: `eval` at the benchmark's
-//! grazing pair), for instruction counts that do not depend on
+//! grazing pair; `sample_fixed`: `sample` for the benchmark's one viewer), for instruction counts that do not depend on
 //! the machine's load (the criterion benchmark `benches/slab.rs` gives
 //! seconds):
 //!
@@ -10,7 +10,7 @@
 //! the build of the sheet is counted too: subtract a run with 0 calls).
 //! An optional fourth argument sets `SlabOptions::walk_orders` (e.g. 48,
 //! the solution's orders: what `eval` costs without the walk's tail).
-//! Arguments: `[preset] [sample|eval|eval_grazing|pdf] [calls] [walk_orders]`.
+//! Arguments: `[preset] [sample|sample_fixed|eval|eval_grazing|pdf] [calls] [walk_orders]`.
 
 use paperbsdf_core::presets::preset;
 use paperbsdf_core::{Bsdf, DVec3};
@@ -51,6 +51,19 @@ fn main() -> Result<(), String> {
                     acc += s.pdf;
                 }
             }
+            // benches/slab.rs `sample`: one viewer, so its node's sampling
+            // cells stay in the cache, as they do in the benchmark.
+            "sample_fixed" => {
+                let wo = DVec3::new(0.3, 0.1, 0.9).normalize();
+                let uc = (0.5 + k as f64 * 0.569_840_290_998).fract();
+                let u = [
+                    (0.5 + k as f64 * 0.412_454_033_64).fract(),
+                    (0.5 + k as f64 * 0.618_033_988_75).fract(),
+                ];
+                if let Some(s) = b.sample(std::hint::black_box(wo), uc, u) {
+                    acc += s.pdf;
+                }
+            }
             "eval" => acc += b.eval(dir(k, 0.3), wo()).mean(),
             // benches/slab.rs `eval_grazing`: near the mirror direction at
             // 78 and 81 degrees, where the node pairs keep the most orders.
@@ -60,7 +73,11 @@ fn main() -> Result<(), String> {
                 acc += b.eval(std::hint::black_box(wi), wo).mean();
             }
             "pdf" => acc += b.pdf(dir(k, 0.3), wo()),
-            _ => return Err(format!("unknown call '{what}' (sample, eval, eval_grazing or pdf)")),
+            _ => {
+                return Err(format!(
+                    "unknown call '{what}' (sample, sample_fixed, eval, eval_grazing or pdf)"
+                ))
+            }
         }
     }
     println!("{name} {what} x {calls}: checksum {acc:.6e}");

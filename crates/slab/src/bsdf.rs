@@ -107,7 +107,7 @@
 //! times a smooth function of the two `mu` (associated Legendre functions
 //! are `sin^m theta` times polynomials in `cos theta`), so there a
 //! corner's order `m` is multiplied by `rho^m`, `rho` the product of the
-//! two directions' `sin theta / sin theta_node` (`SlabBsdf::law_ratio`, 1
+//! two directions' `sin theta / sin theta_node` (`SlabBsdf::law_ratio_of`, 1
 //! for a direction outside the band; `SlabBsdf::law_band_sum`, each
 //! corner against its own `rho^m cos(m phi)`), and near the pole the
 //! other direction's `rho` joins the pole's. Linear weights in `mu` take
@@ -599,7 +599,7 @@ impl Tables {
     }
 
     /// The share `lambda` of the sine law's ratio each node pair takes
-    /// (`SlabBsdf::law_ratio`; module doc, "Between the nodes"): its order
+    /// (`SlabBsdf::law_ratio_of`; module doc, "Between the nodes"): its order
     /// `m` is multiplied by `r^m`, `r = 1 + lambda (rho - 1)`, `rho` the
     /// product of the two directions' ratios, at most `reach[o] reach[j]`
     /// (`reach[k]`: the largest ratio node `k` takes, 1 where none). For
@@ -979,10 +979,11 @@ pub struct SlabBsdf {
     mu: Vec<f64>,
     /// Where a cosine is among `mu`, for `eval`, `sample` and `pdf` ([`NodeGuide`]).
     guide: NodeGuide,
-    /// `sin theta` of the nodes, `sqrt(1 - mu^2)`.
-    sin_nodes: Vec<f64>,
+    /// `1 / sin theta` of the nodes, `1 / sqrt(1 - mu^2)` (infinite at `mu = 1`,
+    /// which no ratio of the sine law's band reads).
+    inv_sin_nodes: Vec<f64>,
     /// The first interval of nodes (`[mu[i], mu[i + 1]]`) whose orders
-    /// follow the sine law (`SlabBsdf::law_ratio`): the first within
+    /// follow the sine law (`SlabBsdf::law_ratio_of`): the first within
     /// [`SIN_LAW_BAND`] of the normal.
     law_from: usize,
     /// `[side of incidence][transmit]`: the Fourier coefficients `c_m[o][j]` ([`Tables`]).
@@ -1035,7 +1036,7 @@ pub struct SlabBsdf {
 
 /// How far from the normal (degrees) the table's Fourier orders follow
 /// the sine law between the nodes (module doc, "Between the nodes";
-/// `SlabBsdf::law_ratio`): in the intervals of nodes within it, the
+/// `SlabBsdf::law_ratio_of`): in the intervals of nodes within it, the
 /// pole's excepted, order `m` of a corner is multiplied by `rho^m`, `rho`
 /// the product of the two directions' `sin theta / sin theta_node` (the
 /// share of it each pair takes, `Tables::limit_law`). A smooth function on
@@ -3123,7 +3124,7 @@ impl SlabBsdf {
             Tables::truncate(direct, n, orders, grey, m_solved, false),
         );
         // Per node of an interval where the orders follow the sine law
-        // (`SlabBsdf::law_ratio`, intervals `law_from..n - 2`): `sin theta`
+        // (`SlabBsdf::law_ratio_of`, intervals `law_from..n - 2`): `sin theta`
         // of the node below it in `mu` over its own, the most a direction
         // between them multiplies its ratio by (`Tables::limit_law`).
         let sin_nodes: Vec<f64> = g.mu.iter().map(|m| (1.0 - m * m).max(0.0).sqrt()).collect();
@@ -3164,7 +3165,7 @@ impl SlabBsdf {
             paper,
             mu: g.mu.clone(),
             guide: NodeGuide::new(&g.mu),
-            sin_nodes,
+            inv_sin_nodes: sin_nodes.iter().map(|s| 1.0 / s).collect(),
             law_from,
             table,
             direct,
@@ -3268,20 +3269,29 @@ impl SlabBsdf {
         }
     }
 
-    /// The sine law's ratio of node `node` for a direction at `p` (module
-    /// doc, "Between the nodes"): `sin theta / sin theta_node` where `p` is
-    /// in an interval of nodes within [`SIN_LAW_BAND`] degrees of the
-    /// normal (the last, the pole's, excepted), else 1.
-    #[inline]
-    fn law_ratio(&self, p: Place, node: usize) -> f64 {
-        if !self.in_law_band(p) {
-            return 1.0;
-        }
-        (1.0 - p.mu * p.mu).max(0.0).sqrt() / self.sin_nodes[node]
+    /// `sin theta` of a direction at `p` where it is in the sine law's
+    /// band, else `None`: what [`SlabBsdf::law_ratio_of`] takes, found once
+    /// per direction (a square root) for the ratios of several nodes.
+    #[inline(always)]
+    fn law_sin(&self, p: Place) -> Option<f64> {
+        self.in_law_band(p).then(|| (1.0 - p.mu * p.mu).max(0.0).sqrt())
+    }
+
+    /// The sine law's ratio of node `node` for a direction whose
+    /// [`SlabBsdf::law_sin`] is `sin` (module doc, "Between the nodes"):
+    /// `sin theta / sin theta_node` where the direction is in an interval
+    /// of nodes within [`SIN_LAW_BAND`] degrees of the normal (the last,
+    /// the pole's, excepted), else 1; a product by the node's reciprocal
+    /// `sin theta` (a square root and a division per corner and direction
+    /// were 4% of glossy's `sample`, perf on examples/sample_cost.rs,
+    /// 2026-12-07).
+    #[inline(always)]
+    fn law_ratio_of(&self, sin: Option<f64>, node: usize) -> f64 {
+        sin.map_or(1.0, |s| s * self.inv_sin_nodes[node])
     }
 
     /// Whether `p` is in an interval where the orders follow the sine law
-    /// ([`SlabBsdf::law_ratio`] is not 1 there).
+    /// ([`SlabBsdf::law_ratio_of`] is not 1 there).
     #[inline(always)]
     fn in_law_band(&self, p: Place) -> bool {
         let i = p.at.0;
@@ -3308,11 +3318,13 @@ impl SlabBsdf {
         c: f64,
     ) -> [f64; K] {
         let (j, o) = (wi.at.0, wo.at.0);
-        let r: [f64; 3] = std::array::from_fn(|k| {
+        let (si, so) = (self.law_sin(wi), self.law_sin(wo));
+        let mut r = [1.0; 3];
+        for (k, r) in r.iter_mut().enumerate() {
             let (a, b) = corners[k];
-            let rho = self.law_ratio(wo, o + a) * self.law_ratio(wi, j + b);
-            1.0 + tab.law_share(st, pairs[k]) * (rho - 1.0)
-        });
+            let rho = self.law_ratio_of(so, o + a) * self.law_ratio_of(si, j + b);
+            *r = 1.0 + tab.law_share(st, pairs[k]) * (rho - 1.0);
+        }
         law_sum::<K>(tab, st, pairs, weights, r, c)
     }
 
@@ -3331,7 +3343,7 @@ impl SlabBsdf {
         let pairs = corners.map(|(a, b)| (o + a) * n + j + b);
         let acc = match pole_corners(&self.mu, wi, wo) {
             // Outside the sine law's band both ways every ratio is 1
-            // (`SlabBsdf::law_ratio`): the plain sum, kept apart from the
+            // (`SlabBsdf::law_ratio_of`): the plain sum, kept apart from the
             // band's so that the common case stays small.
             None if !(self.in_law_band(wi) || self.in_law_band(wo)) => match tab.channels {
                 1 => Rgb::splat(fourier_sum::<1>(tab, st, pairs, weights, c)[0]),
@@ -3345,8 +3357,9 @@ impl SlabBsdf {
                 // The other direction's sine law on the corners' orders
                 // (each pair's share of it, as in `law_band_sum`).
                 if let Some((p, node)) = pole.other.filter(|(p, _)| self.in_law_band(*p)) {
+                    let sin = self.law_sin(p);
                     for (k, r) in pole.r.iter_mut().enumerate() {
-                        *r *= 1.0 + tab.law_share(st, pole.pairs[k]) * (self.law_ratio(p, node + k) - 1.0);
+                        *r *= 1.0 + tab.law_share(st, pole.pairs[k]) * (self.law_ratio_of(sin, node + k) - 1.0);
                     }
                 }
                 match tab.channels {
