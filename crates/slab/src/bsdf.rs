@@ -1653,7 +1653,10 @@ const GUIDE_CELLS: usize = 512;
 /// 2026-12-07).
 #[derive(Clone, Debug)]
 struct NodeGuide {
+    /// Per cell, its lower end's interval (16 bits: a grid has at most
+    /// [`crate::slab::MAX_NODES`] nodes).
     start: Vec<u16>,
+    /// Per interval, `1 / (mu[i + 1] - mu[i])`.
     inv_width: Vec<f64>,
 }
 

@@ -130,14 +130,23 @@ pub struct SlabSpec {
     pub back: Face,
 }
 
+/// Most nodes per hemisphere outside, and in a cone of total internal
+/// reflection, that a solve takes ([`Discretisation::nodes`],
+/// [`Discretisation::tir_nodes`]): every order solves dense systems on
+/// all the nodes of a sheet's grids (a face's walk on twice as many): at
+/// 1024 outside nodes one outside-by-outside matrix of one order is 8 MB.
+/// A larger request is refused with an error rather than exhausting the
+/// memory (and `SlabBsdf`'s node guide keeps intervals in 16 bits).
+pub const MAX_NODES: usize = 1024;
+
 /// How finely the solver discretises.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Discretisation {
-    /// Gauss-Radau nodes per hemisphere outside (air), at least 2; the inside
+    /// Gauss-Radau nodes per hemisphere outside (air), 2 to [`MAX_NODES`]; the inside
     /// grid has as many in the cone that refracts out ([`crate::quad`]).
     pub nodes: usize,
-    /// Gauss-Legendre nodes in each cone of total internal reflection, at
-    /// least 1: the inside grid's cone beyond the air's critical angle (when
+    /// Gauss-Legendre nodes in each cone of total internal reflection, 1
+    /// to [`MAX_NODES`]: the inside grid's cone beyond the air's critical angle (when
     /// the medium's index exceeds 1) and, for a coated sheet, the denser
     /// medium's cone beyond the coating/base boundary's critical angle
     /// ([`Grid::denser`]).
@@ -260,18 +269,18 @@ impl SlabSpec {
     /// and thickness (one call per colour channel).
     pub fn prepare(&self, disc: &Discretisation) -> Result<Prepared, SlabError> {
         self.validate()?;
-        if disc.nodes < 2 {
+        if !(2..=MAX_NODES).contains(&disc.nodes) {
             return Err(SlabError::Discretisation {
                 name: "nodes",
                 value: disc.nodes as f64,
-                range: "[2, inf)",
+                range: "[2, 1024]",
             });
         }
-        if disc.tir_nodes < 1 {
+        if !(1..=MAX_NODES).contains(&disc.tir_nodes) {
             return Err(SlabError::Discretisation {
                 name: "tir_nodes",
                 value: disc.tir_nodes as f64,
-                range: "[1, inf)",
+                range: "[1, 1024]",
             });
         }
         let outside = Grid::outside(disc.nodes);

@@ -7,6 +7,7 @@
 //! parameter and its range.
 
 use paperbsdf_core::phase::TwoLobeHg;
+use paperbsdf_slab::slab::MAX_NODES;
 use paperbsdf_slab::{Discretisation, Face, Medium, Side, SlabError, SlabSpec};
 use std::f64::consts::PI;
 
@@ -165,7 +166,21 @@ fn bad_input_is_a_typed_error_naming_the_parameter() {
     assert!(matches!(e, SlabError::Param(_)) && e.to_string().contains("tau"), "{e}");
     for (d, name) in [
         (Discretisation { nodes: 1, ..disc }, "nodes"),
+        (
+            Discretisation {
+                nodes: MAX_NODES + 1,
+                ..disc
+            },
+            "nodes",
+        ),
         (Discretisation { tir_nodes: 0, ..disc }, "tir_nodes"),
+        (
+            Discretisation {
+                tir_nodes: MAX_NODES + 1,
+                ..disc
+            },
+            "tir_nodes",
+        ),
         (Discretisation { orders: 0, ..disc }, "orders"),
         (
             Discretisation {
@@ -180,5 +195,9 @@ fn bad_input_is_a_typed_error_naming_the_parameter() {
             matches!(e, SlabError::Discretisation { .. }) && e.to_string().contains(name),
             "{name}: {e}"
         );
+        // The allowed range the message gives is the one enforced.
+        if d.nodes > MAX_NODES || d.tir_nodes > MAX_NODES {
+            assert!(e.to_string().contains(&format!("{MAX_NODES}]")), "{name}: {e}");
+        }
     }
 }
