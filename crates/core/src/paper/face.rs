@@ -657,8 +657,8 @@ impl Face {
     /// plus this, summed directly rather than as the face's reflection less
     /// the coating's lobe (a difference that rounding could take below 0,
     /// and that read the tables for the coating's lobe only to take it
-    /// away: a tenth of the model `slab`'s `eval` on a coated sheet, perf,
-    /// 2026-12-07).
+    /// away: about 5% of the model `slab`'s `eval` on glossy at the
+    /// grazing pair, perf on its examples/sample_cost.rs, 2026-12-07).
     #[inline(always)]
     fn compensation_beside_coat(&self, pi: impl Fn() -> TabPos, po: impl Fn() -> TabPos) -> f64 {
         if self.lobes.len() < 2 {
