@@ -38,10 +38,11 @@ use paperbsdf_slab::{SlabBsdf, SlabOptions};
 #[path = "../../sim/examples/support/cases.rs"]
 mod cases;
 
-/// `eval` (mean over channels) on 32, 64 and 128 nodes at `(theta_i, theta_o, transmit)`.
-fn row(p: &PaperParams, points: &[(f64, f64, bool)]) {
+/// The sheet `p` built with `k` times the default nodes (and nodes in the
+/// cone of total reflection) for each `k` of `times`.
+fn with_nodes_times(p: &PaperParams, times: &[usize]) -> Vec<SlabBsdf> {
     let base = SlabOptions::default();
-    let bsdfs: Vec<SlabBsdf> = [1, 2, 4]
+    times
         .iter()
         .map(|&k| {
             let o = SlabOptions {
@@ -51,7 +52,12 @@ fn row(p: &PaperParams, points: &[(f64, f64, bool)]) {
             };
             SlabBsdf::with_options(p, &o).expect("build")
         })
-        .collect();
+        .collect()
+}
+
+/// `eval` (mean over channels) on 32, 64 and 128 nodes at `(theta_i, theta_o, transmit)`.
+fn row(p: &PaperParams, points: &[(f64, f64, bool)]) {
+    let bsdfs = with_nodes_times(p, &[1, 2, 4]);
     for &(ti, to, tr) in points {
         let (wi, wo) = in_plane_directions(ti, to, tr);
         let v: Vec<f64> = bsdfs.iter().map(|b| b.eval(wi, wo).mean()).collect();
@@ -76,18 +82,7 @@ fn table_part(p: &PaperParams, points: &[(f64, f64)]) {
         face_scattering: FaceScattering::Multiple,
         ..p.clone()
     };
-    let base = SlabOptions::default();
-    let bsdfs: Vec<SlabBsdf> = [1, 2, 4]
-        .iter()
-        .map(|&k| {
-            let o = SlabOptions {
-                nodes: k * base.nodes,
-                tir_nodes: k * base.tir_nodes,
-                ..base
-            };
-            SlabBsdf::with_options(&p, &o).expect("build")
-        })
-        .collect();
+    let bsdfs = with_nodes_times(&p, &[1, 2, 4]);
     for &(ti, to) in points {
         let (wi, wo) = in_plane_directions(ti, to, false);
         let v: Vec<f64> = bsdfs.iter().map(|b| b.eval(wi, wo).mean()).collect();
@@ -115,18 +110,12 @@ fn table_part(p: &PaperParams, points: &[(f64, f64)]) {
 /// less its unscattered part, both relative to the value (values above
 /// 1e-3 of the largest).
 fn scattered_alone(name: &str, p: &PaperParams) {
-    let base = SlabOptions::default();
-    let doubled = SlabOptions {
-        nodes: 2 * base.nodes,
-        tir_nodes: 2 * base.tir_nodes,
-        ..base
-    };
-    let b = [base, doubled].map(|o| SlabBsdf::with_options(p, &o).expect("build"));
+    let b = with_nodes_times(p, &[1, 2]);
     let mut rows = Vec::new();
     for ti in (0..=160).map(|k| 0.5 * k as f64) {
         for to in (-160..=160).map(|k| 0.5 * k as f64) {
             let (wi, wo) = in_plane_directions(ti, to, true);
-            let [(t0, s0), (t1, s1)] = b.each_ref().map(|b| {
+            let [(t0, s0), (t1, s1)] = [&b[0], &b[1]].map(|b| {
                 let t = b.eval(wi, wo).mean();
                 (t, t - b.eval_component(wi, wo, Component::Direct).mean())
             });
