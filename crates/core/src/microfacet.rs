@@ -81,7 +81,12 @@ impl Microfacet {
             }
             Distribution::Beckmann => {
                 let tan2 = (1.0 - c2).max(0.0) / c2;
-                let e = (-tan2 / a2).exp();
+                let x = -tan2 / a2;
+                // Below EXP_ZERO the exponential is 0: skipping the call
+                // skips its slow underflow path, which a narrow lobe
+                // projected on a grid takes at most of its points (1% of
+                // a sheet's build in perf, examples/slab_build.rs glossy).
+                let e = if x < EXP_ZERO { 0.0 } else { x.exp() };
                 // At extreme grazing both factors underflow: the limit is 0.
                 if e == 0.0 {
                     0.0
@@ -641,6 +646,26 @@ pub(crate) fn upper_unit(h: DVec3) -> Option<DVec3> {
 mod tests {
     use super::*;
     use crate::geometry::spherical_direction;
+
+    /// Beckmann's `D` skips `exp` below [`EXP_ZERO`]: the same values as
+    /// the formula with the call, bit for bit, for micro-normals 10 to 20
+    /// degrees from the normal: exponents -78 to -331 (alpha 0.02, all
+    /// above it), -555 to -2355 (alpha 0.0075, crossing it at 11.6
+    /// degrees), -1244 to -5300 (alpha 0.005, all below it).
+    #[test]
+    fn beckmann_d_underflow_guard_is_exact() {
+        for alpha in [0.02, 0.0075, 0.005] {
+            let mf = Microfacet::new(Distribution::Beckmann, alpha);
+            for k in 0..=2000 {
+                let theta = (10.0 + 10.0 * k as f64 / 2000.0).to_radians();
+                let h = DVec3::new(theta.sin(), 0.0, theta.cos());
+                let (c2, a2) = (h.z * h.z, alpha * alpha);
+                let e = (-(1.0 - c2) / c2 / a2).exp();
+                let reference = if e == 0.0 { 0.0 } else { e / (PI * a2 * c2 * c2) };
+                assert_eq!(mf.d(h).to_bits(), reference.to_bits(), "alpha {alpha}, theta_h {theta}");
+            }
+        }
+    }
 
     /// The fast inverse error function against the refined one.
     #[test]

@@ -177,7 +177,7 @@ use crate::error::SlabError;
 use crate::layer::Layer;
 use crate::quad::Grid;
 use nalgebra::DMatrix;
-use paperbsdf_core::boundary::{dir_at_mu, directional_albedo_n};
+use paperbsdf_core::boundary::{dir_at_mu, directional_albedo_rule};
 use paperbsdf_core::dielectric::Interface;
 use paperbsdf_core::fresnel::{cos_transmitted, fresnel_dielectric};
 use paperbsdf_core::microsurface_tables::compensation_shares;
@@ -751,9 +751,10 @@ fn refraction_edge_cells(
 /// to the transmittance that lobe leaves (crates/slab/src/bsdf.rs). Light
 /// reaches `r_top` from nowhere else.
 fn normalise_face(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut [Layer]) -> Result<Vec<f64>, SlabError> {
+    let rule = gauss_legendre_01(ALBEDO_POINTS);
     let target = |g: &Grid, side: f64| -> Vec<(f64, f64)> {
         g.mu.par_iter()
-            .map(|&mu| directional_albedo_n(bd, dir_at_mu(mu, side), ALBEDO_POINTS))
+            .map(|&mu| directional_albedo_rule(bd, dir_at_mu(mu, side), &rule))
             .collect()
     };
     let t_out: Vec<f64> = target(outside, 1.0).iter().map(|(r, t)| r + t).collect();

@@ -32,6 +32,14 @@ pub fn directional_albedo(b: &RoughDielectric, w: DVec3) -> (f64, f64) {
 
 /// As [`directional_albedo`] with `n` quadrature points per axis.
 pub fn directional_albedo_n(b: &RoughDielectric, w: DVec3, n: usize) -> (f64, f64) {
+    directional_albedo_rule(b, w, &gauss_legendre_01(n))
+}
+
+/// As [`directional_albedo`] on the Gauss-Legendre rule `(x, wt)` on `[0, 1]`
+/// ([`gauss_legendre_01`]), per axis: for callers that take many albedos on
+/// one rule and compute it once (the rule's Newton iterations cost as much
+/// as a 128-point albedo's quadrature).
+pub fn directional_albedo_rule(b: &RoughDielectric, w: DVec3, (x, wt): &(Vec<f64>, Vec<f64>)) -> (f64, f64) {
     let mf = match b.interface {
         Interface::IndexMatched => return (0.0, 1.0),
         Interface::Smooth => {
@@ -44,10 +52,9 @@ pub fn directional_albedo_n(b: &RoughDielectric, w: DVec3, n: usize) -> (f64, f6
         return (0.0, 0.0);
     }
     let eta_ti = if w.z > 0.0 { 1.0 / b.eta } else { b.eta };
-    let (x, wt) = gauss_legendre_01(n);
     // Both visible-normal maps are separable on a tensor grid (one
     // inversion per row and per column; the samplers' values).
-    let normals = mf.visible_normal_grid(w, &x);
+    let normals = mf.visible_normal_grid(w, x);
     let (mut r, mut t) = (0.0, 0.0);
     for i in 0..x.len() {
         for j in 0..x.len() {
