@@ -88,3 +88,67 @@ fn totals_agree_with_the_simulator() {
     }
     println!("largest |slab - simulator| - 3 sigma: {worst:+.1e} (allowed {TOLERANCE:.0e})");
 }
+
+/// Faces close to index-matched whose projection the normalisation takes
+/// to within [`paperbsdf_slab::interface::NORMALISATION_SLOW_TOLERANCE`] but not to its 1e-12 target
+/// (refused until 2026-12-07; crates/slab/src/interface.rs,
+/// `normalise_face`): the thin sheet of the test above with both faces so,
+/// lit on the front at the normal and at 75.3 degrees, both face modes,
+/// against the simulator with the same tolerance.
+///
+/// Measured while writing this with 480k walks (sigma 3e-4 to 9e-4): at
+/// the normal every total within 6e-4; at 75.3 degrees slab's reflectance
+/// is below the simulator's by up to 4.6e-3 (Beckmann 1.12, m = 0.1,
+/// `"single"`; 3.7e-3 `"multiple"`), 2.1e-3 for GGX 1.1 with m = 0.05.
+/// That is not the new faces' alone: faces accepted before show it too,
+/// falling with the index (Beckmann m = 0.1 at 75.3 degrees, `"single"`:
+/// 3.1e-3 at eta 1.15, 1.8e-3 at 1.2, 0 at 1.3; the same run with those
+/// faces, not kept). A smooth face close to index-matched at grazing
+/// incidence is the solver's weakest face; README, "Faces close to
+/// index-matched".
+#[test]
+fn near_index_matched_faces_agree_with_the_simulator() {
+    let disc = Discretisation::default();
+    let mut worst = f64::NEG_INFINITY;
+    for fs in [FaceScattering::Single, FaceScattering::Multiple] {
+        for (eta, m, dist) in [
+            (1.1, 0.05, Distribution::Ggx),
+            (1.12, 0.1, Distribution::Beckmann),
+            (1.05, 0.3, Distribution::Ggx),
+            (1.08, 0.8, Distribution::Ggx),
+        ] {
+            let p = PaperParams {
+                eta_f: eta,
+                eta_b: eta,
+                m_f: m,
+                m_b: m,
+                dist_f: dist,
+                dist_b: dist,
+                ..sheet(0.01, 200.0, 0.5, fs)
+            };
+            let sol = SlabSpec::from_params(&p, 0).unwrap().solve(&disc).unwrap();
+            let slab = Slab::from_params(&p).unwrap();
+            let g = &sol.outside;
+            for j in [g.len() - 1, 10] {
+                let mu = g.mu[j];
+                let wi = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
+                let (r, t) = sol.totals_collimated(Side::Front, j);
+                let (sr, se_r, st, se_t) = simulated_totals(&slab, wi, 240_000, 29 + j as u64);
+                println!(
+                    "{fs:?} eta {eta} {dist:?} m {m} theta {:.1}: slab R {r:.4} T {t:.4}; simulator R {sr:.4} +- {se_r:.4} T {st:.4} +- {se_t:.4}",
+                    mu.acos().to_degrees()
+                );
+                for (what, a, b, se) in [("R", r, sr, se_r), ("T", t, st, se_t)] {
+                    let excess = (a - b).abs() - 3.0 * se;
+                    worst = worst.max(excess);
+                    assert!(
+                        excess <= TOLERANCE,
+                        "{fs:?} eta {eta} {dist:?} m {m} theta {:.1} {what}: slab {a} simulator {b} +- {se}",
+                        mu.acos().to_degrees()
+                    );
+                }
+            }
+        }
+    }
+    println!("largest |slab - simulator| - 3 sigma: {worst:+.1e} (allowed {TOLERANCE:.0e})");
+}
