@@ -36,11 +36,12 @@ pub enum SlabError {
     },
     /// A rough face whose projection on the grid cannot be scaled to the
     /// face's own albedo (known for faces close to index-matched: `eta`
-    /// between 1 and about 1.1).
+    /// up to 1.03 at any roughness, to about 1.1 for smooth faces).
     #[error(
         "the model `slab` cannot represent the rough face of index {eta} ({dist}, m = {m}): its projection on the grid \
          did not converge to the face's albedo; `slab` does not support faces this close to index-matched yet \
-         (eta between 1 and about 1.1, more nodes do not help); the model `paper` does"
+         (eta up to 1.03 whatever the roughness, up to about 1.1 for smooth faces; more nodes do not help); \
+         the model `paper` does"
     )]
     UnresolvedFace {
         /// The face's relative index.

@@ -18,7 +18,9 @@ mod support;
 
 use paperbsdf_core::{Distribution, FaceScattering, Microfacet, RoughDielectric};
 use paperbsdf_slab::face_walk::{multiple_scattering, single_scattering};
-use paperbsdf_slab::interface::{face_interface, refraction_edge_pairs, Projection};
+use paperbsdf_slab::interface::{
+    face_interface, refraction_edge_pairs, snell_image_pairs, snell_image_share, Projection,
+};
 use paperbsdf_slab::Grid;
 use support::layer_asymmetry;
 
@@ -40,6 +42,13 @@ fn grids(eta: f64, nodes: usize) -> (Grid, Grid) {
 /// m = 0.8 (3.8e-2 and 0.31 while the chain sampled the edge at the nodes);
 /// asked 0.05. The cell averages themselves are checked against core's
 /// albedo in tests/rough_face.rs and by the walk's energy below.
+/// Also apart: the transmission entries around each node's Snell image,
+/// which the projection holds as a share of the cells' averages for lobes
+/// no wider than the nodes' spacing (`interface::snell_image_share`, 0.69
+/// for GGX m = 0.3 on these 16 nodes, 0 for 0.8 and for Beckmann 0.4)
+/// while the chain keeps the nodes' values: its order 1 is not used (the
+/// walk adds orders >= 2 to the projection, normalised to what the
+/// projection loses); not asked.
 #[test]
 fn order_one_is_walters_projection() {
     let (out, ins) = grids(1.5, 16);
@@ -62,6 +71,12 @@ fn order_one_is_walters_projection() {
         } else {
             Vec::new()
         };
+        let image = if snell_image_share(&bd, out.len()) > 0.0 {
+            snell_image_pairs(&out, &ins)
+        } else {
+            Vec::new()
+        };
+        let averaged = |a: usize, b: usize| image.contains(&(a, b)) && !edge.contains(&(a, b));
         let (mut worst, mut at_edge): (f64, f64) = (0.0, 0.0);
         for (w, c) in walter.orders.iter().zip(&chain) {
             for (a, b, down) in [
@@ -74,11 +89,14 @@ fn order_one_is_walters_projection() {
                 for o in 0..a.nrows() {
                     for j in 0..a.ncols() {
                         let d = (a[(o, j)] - b[(o, j)]).abs() / scale;
-                        let on_edge = match down {
-                            Some(true) => edge.contains(&(o, j)),
-                            Some(false) => edge.contains(&(j, o)),
-                            None => false,
+                        let (on_edge, on_image) = match down {
+                            Some(true) => (edge.contains(&(o, j)), averaged(o, j)),
+                            Some(false) => (edge.contains(&(j, o)), averaged(j, o)),
+                            None => (false, false),
                         };
+                        if on_image {
+                            continue;
+                        }
                         if on_edge {
                             at_edge = at_edge.max(d);
                         } else {

@@ -116,7 +116,11 @@ fn sheets_with_unequal_rough_faces_are_reciprocal_in_every_order() {
         }
         let (r_f, _) = sol.totals_normal(Side::Front);
         let (r_b, _) = sol.totals_normal(Side::Back);
-        assert!((r_f - r_b).abs() > 1e-3, "the faces differ: {r_f} {r_b}");
+        // That the two faces differ, so that the relations are not met by
+        // symmetry: 9.6e-4 apart at the normal (1e-3 and more until the
+        // Snell image's cell averages of 2026-12-07 moved the front's
+        // transmission); the threshold only has to tell them from equal.
+        assert!((r_f - r_b).abs() > 5e-4, "the faces differ: {r_f} {r_b}");
     }
     println!("worst relative asymmetry of the sheet (8 orders): {worst:.1e}");
     assert!(worst < 1e-10, "{worst}");

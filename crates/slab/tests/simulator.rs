@@ -89,23 +89,32 @@ fn totals_agree_with_the_simulator() {
     println!("largest |slab - simulator| - 3 sigma: {worst:+.1e} (allowed {TOLERANCE:.0e})");
 }
 
-/// Faces close to index-matched whose projection the normalisation takes
-/// to within [`paperbsdf_slab::interface::NORMALISATION_SLOW_TOLERANCE`] but not to its 1e-12 target
-/// (refused until 2026-12-07; crates/slab/src/interface.rs,
-/// `normalise_face`): the thin sheet of the test above with both faces so,
-/// lit on the front at the normal and at 75.3 degrees, both face modes,
-/// against the simulator with the same tolerance.
+/// Faces close to index-matched: the thin sheet of the test above with
+/// both faces so, lit on the front at the outside nodes of 0, 43.5, 75.3
+/// and 85.5 degrees, both face modes, against the simulator with the same
+/// tolerance. Some of these faces were refused until 2026-12-07 (the
+/// normalisation reached 1e-10, not 1e-12: Beckmann eta 1.12, m = 0.1; or
+/// could not scale the nodes' values at all: GGX 1.05, m = 0.3), and their
+/// lobe around the Snell image is narrower than the nodes' cells
+/// (crates/slab/src/interface.rs, "Narrow transmission lobes"): with the
+/// nodes' values alone slab's reflectance was 4.5e-3 under the
+/// simulator's at 75.3 degrees (7.9 sigma at 480k walks, Beckmann 1.12,
+/// `"single"`) and 4.9e-3 at 85.5 (`"multiple"`); with the cells' averages the largest
+/// difference is 2.3e-3 (3.8 sigma, 85.5 degrees, `"multiple"`) and the
+/// RMS 7.5e-4 over these and two paper-like faces
+/// (examples/near_index_totals.rs, 480k walks).
 ///
-/// Measured while writing this with 480k walks (sigma 3e-4 to 9e-4): at
-/// the normal every total within 6e-4; at 75.3 degrees slab's reflectance
-/// is below the simulator's by up to 4.6e-3 (Beckmann 1.12, m = 0.1,
-/// `"single"`; 3.7e-3 `"multiple"`), 2.1e-3 for GGX 1.1 with m = 0.05.
-/// That is not the new faces' alone: faces accepted before show it too,
-/// falling with the index (Beckmann m = 0.1 at 75.3 degrees, `"single"`:
-/// 3.1e-3 at eta 1.15, 1.8e-3 at 1.2, 0 at 1.3; the same run with those
-/// faces, not kept). A smooth face close to index-matched at grazing
-/// incidence is the solver's weakest face; README, "Faces close to
-/// index-matched".
+/// **Tolerance** `3 sigma + 1.5e-3` ([`NEAR_INDEX_TOLERANCE`]), half the
+/// test above's: these faces reflect little (Fresnel 3.2e-3 at normal
+/// incidence for eta 1.12, against 0.04 for 1.5), so the error of the
+/// faces' split between R and T, which most of that test's 3e-3 holds
+/// (2.2e-3), is smaller by as much; the discretisation's 5.6e-4 stays.
+/// The nodes' values alone fail it (checked with the projection of the
+/// commit before: 85.5 degrees, Beckmann 1.12, `"multiple"`).
+/// The tolerance of [`near_index_matched_faces_agree_with_the_simulator`]
+/// beyond 3 sigma (its doc).
+const NEAR_INDEX_TOLERANCE: f64 = 1.5e-3;
+
 #[test]
 fn near_index_matched_faces_agree_with_the_simulator() {
     let disc = Discretisation::default();
@@ -129,7 +138,7 @@ fn near_index_matched_faces_agree_with_the_simulator() {
             let sol = SlabSpec::from_params(&p, 0).unwrap().solve(&disc).unwrap();
             let slab = Slab::from_params(&p).unwrap();
             let g = &sol.outside;
-            for j in [g.len() - 1, 10] {
+            for j in [g.len() - 1, 20, 10, 5] {
                 let mu = g.mu[j];
                 let wi = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
                 let (r, t) = sol.totals_collimated(Side::Front, j);
@@ -142,7 +151,7 @@ fn near_index_matched_faces_agree_with_the_simulator() {
                     let excess = (a - b).abs() - 3.0 * se;
                     worst = worst.max(excess);
                     assert!(
-                        excess <= TOLERANCE,
+                        excess <= NEAR_INDEX_TOLERANCE,
                         "{fs:?} eta {eta} {dist:?} m {m} theta {:.1} {what}: slab {a} simulator {b} +- {se}",
                         mu.acos().to_degrees()
                     );
@@ -150,5 +159,5 @@ fn near_index_matched_faces_agree_with_the_simulator() {
             }
         }
     }
-    println!("largest |slab - simulator| - 3 sigma: {worst:+.1e} (allowed {TOLERANCE:.0e})");
+    println!("largest |slab - simulator| - 3 sigma: {worst:+.1e} (allowed {NEAR_INDEX_TOLERANCE:.1e})");
 }

@@ -1,0 +1,36 @@
+//! Which faces close to index-matched `slab` builds and which it refuses
+//! (`SlabError::UnresolvedFace`; README, "Faces close to index-matched"):
+//! the matte preset with both faces of index `eta` and roughness `m`, both
+//! distributions and both face modes, default discretisation.
+//!
+//! `cargo run --release -p paperbsdf-slab --example near_index_support`
+//! (about two minutes on two cores).
+
+use paperbsdf_core::{Distribution, FaceScattering, PaperParams};
+use paperbsdf_slab::SlabBsdf;
+
+fn main() {
+    let base = paperbsdf_core::presets::matte_office();
+    for fs in [FaceScattering::Single, FaceScattering::Multiple] {
+        for dist in [Distribution::Ggx, Distribution::Beckmann] {
+            for eta in [1.001, 1.01, 1.02, 1.03, 1.05, 1.08, 1.1, 1.11, 1.12] {
+                let mut line = format!("{:8} {:8} eta {eta:<5}:", fs.name(), dist.name());
+                for m in [0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.8, 1.2] {
+                    let p = PaperParams {
+                        eta_f: eta,
+                        eta_b: eta,
+                        m_f: m,
+                        m_b: m,
+                        dist_f: dist,
+                        dist_b: dist,
+                        face_scattering: fs,
+                        ..base.clone()
+                    };
+                    let built = SlabBsdf::new(&p).is_ok();
+                    line += &format!("  m {m} {}", if built { "built" } else { "REFUSED" });
+                }
+                println!("{line}");
+            }
+        }
+    }
+}
