@@ -6,8 +6,12 @@
 //! `cargo run --release -p paperbsdf-slab --example near_index_support`
 //! (about two minutes on two cores).
 
+#[path = "../tests/support/mod.rs"]
+mod support;
+
 use paperbsdf_core::{Distribution, FaceScattering, PaperParams};
 use paperbsdf_slab::SlabBsdf;
+use support::with_both_faces;
 
 fn main() {
     let base = paperbsdf_core::presets::matte_office();
@@ -16,16 +20,15 @@ fn main() {
             for eta in [1.001, 1.01, 1.02, 1.03, 1.05, 1.08, 1.1, 1.11, 1.12] {
                 let mut line = format!("{:8} {:8} eta {eta:<5}:", fs.name(), dist.name());
                 for m in [0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 0.8, 1.2] {
-                    let p = PaperParams {
-                        eta_f: eta,
-                        eta_b: eta,
-                        m_f: m,
-                        m_b: m,
-                        dist_f: dist,
-                        dist_b: dist,
-                        face_scattering: fs,
-                        ..base.clone()
-                    };
+                    let p = with_both_faces(
+                        PaperParams {
+                            face_scattering: fs,
+                            ..base.clone()
+                        },
+                        eta,
+                        m,
+                        dist,
+                    );
                     let built = SlabBsdf::new(&p).is_ok();
                     line += &format!("  m {m} {}", if built { "built" } else { "REFUSED" });
                 }

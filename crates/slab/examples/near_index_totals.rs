@@ -18,7 +18,7 @@ mod support;
 use paperbsdf_core::{Colour, DVec3, Distribution, FaceScattering, PaperParams};
 use paperbsdf_sim::Slab;
 use paperbsdf_slab::{Discretisation, Side, SlabSpec};
-use support::simulated_totals;
+use support::{simulated_totals, with_both_faces};
 
 fn main() {
     let walks: u64 = std::env::args()
@@ -33,19 +33,14 @@ fn main() {
             (1.5, 0.1, Distribution::Beckmann),
             (1.5, 0.15, Distribution::Ggx),
         ] {
-            let p = PaperParams {
+            let thin = PaperParams {
                 d: 0.01,
                 sigma_s: Colour::Scalar(200.0),
                 sigma_a: Colour::Scalar(0.5),
-                eta_f: eta,
-                eta_b: eta,
-                m_f: m,
-                m_b: m,
-                dist_f: dist,
-                dist_b: dist,
                 face_scattering: fs,
                 ..paperbsdf_core::presets::matte_office()
             };
+            let p = with_both_faces(thin, eta, m, dist);
             let sol = match SlabSpec::from_params(&p, 0).and_then(|s| s.solve(&Discretisation::default())) {
                 Ok(sol) => sol,
                 Err(e) => {

@@ -745,35 +745,18 @@ fn refraction_edge_cells(
     } else {
         Vec::new()
     };
+    let mut average = |pairs: &[(usize, usize)], share: f64, points: usize| {
+        cell_averages(bd, outside, inside, phis, cos_w, (pairs, share), points, t_down, t_up)
+    };
     let share = snell_image_share(bd, outside.len());
     if share > 0.0 {
         let image: Vec<(usize, usize)> = snell_image_pairs(outside, inside)
             .into_iter()
             .filter(|p| !edge.contains(p))
             .collect();
-        cell_averages(
-            bd,
-            outside,
-            inside,
-            phis,
-            cos_w,
-            (&image, share),
-            SNELL_IMAGE_POINTS,
-            t_down,
-            t_up,
-        );
+        average(&image, share, SNELL_IMAGE_POINTS);
     }
-    cell_averages(
-        bd,
-        outside,
-        inside,
-        phis,
-        cos_w,
-        (&edge, 1.0),
-        EDGE_POINTS,
-        t_down,
-        t_up,
-    );
+    average(&edge, 1.0, EDGE_POINTS);
 }
 
 /// The share of the cell averages at the Snell image's pairs (module doc,

@@ -30,7 +30,7 @@ mod support;
 use paperbsdf_core::{Colour, DVec3, Distribution, FaceScattering, PaperParams};
 use paperbsdf_sim::Slab;
 use paperbsdf_slab::{Discretisation, Side, SlabSpec};
-use support::simulated_totals;
+use support::{simulated_totals, with_both_faces};
 
 fn sheet(d: f64, sigma_s: f64, sigma_a: f64, fs: FaceScattering) -> PaperParams {
     PaperParams {
@@ -126,15 +126,7 @@ fn near_index_matched_faces_agree_with_the_simulator() {
             (1.05, 0.3, Distribution::Ggx),
             (1.08, 0.8, Distribution::Ggx),
         ] {
-            let p = PaperParams {
-                eta_f: eta,
-                eta_b: eta,
-                m_f: m,
-                m_b: m,
-                dist_f: dist,
-                dist_b: dist,
-                ..sheet(0.01, 200.0, 0.5, fs)
-            };
+            let p = with_both_faces(sheet(0.01, 200.0, 0.5, fs), eta, m, dist);
             let sol = SlabSpec::from_params(&p, 0).unwrap().solve(&disc).unwrap();
             let slab = Slab::from_params(&p).unwrap();
             let g = &sol.outside;

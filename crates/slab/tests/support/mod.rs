@@ -2,13 +2,14 @@
 //! a layer's matrices, the simulator's totals for collimated light, a
 //! deterministic rule for the integral of a BSDF over the outgoing
 //! direction, a sheet built with the default and with twice the nodes, and
-//! the directions around the lobes of `two_crossings` ([`lobe_points`]).
+//! the directions around the lobes of `two_crossings` ([`lobe_points`]),
+//! and a sheet given two alike faces ([`with_both_faces`]).
 #![allow(dead_code)]
 
 pub mod lobe_points;
 
 use nalgebra::DMatrix;
-use paperbsdf_core::DVec3;
+use paperbsdf_core::{DVec3, Distribution, PaperParams};
 use paperbsdf_sim::{simulate_totals, Incidence, SimConfig, Slab};
 use paperbsdf_slab::{Grid, Layer};
 use std::f64::consts::PI;
@@ -107,4 +108,19 @@ pub fn default_and_doubled_nodes(
         SlabBsdf::with_options(p, &base).unwrap(),
         SlabBsdf::with_options(p, &doubled).unwrap(),
     )
+}
+
+/// `p` with both faces of index `eta`, roughness `m` and distribution
+/// `dist` (the faces close to index-matched of tests/simulator.rs and
+/// examples/near_index_*.rs).
+pub fn with_both_faces(p: PaperParams, eta: f64, m: f64, dist: Distribution) -> PaperParams {
+    PaperParams {
+        eta_f: eta,
+        eta_b: eta,
+        m_f: m,
+        m_b: m,
+        dist_f: dist,
+        dist_b: dist,
+        ..p
+    }
 }
