@@ -119,7 +119,7 @@
 //! tilted by `delta` turns the refracted direction at normal incidence by
 //! `(1 - 1/eta) delta`, so for faces close to index-matched or smooth the
 //! lobe is narrower than the nodes' spacing (Beckmann eta 1.12, m = 0.1:
-//! 0.8 degrees wide at half maximum, against cells of about 3 degrees).
+//! 1.0 degree wide at half maximum, against cells of about 2.8 degrees).
 //! Sampled at the nodes it was a few node values that the normalisation
 //! scaled to the right albedo but not to the right place: a thin sheet
 //! with such faces reflected 4.5e-3 less than the simulator at 75.3
@@ -141,7 +141,7 @@
 //! faces at 85.5 degrees), the simulator's noise. It also lets the
 //! normalisation converge for faces it could not scale before (GGX and
 //! Beckmann eta 1.05 with m 0.2 to 0.8, 1.08 from 0.05 or 0.1). About
-//! 40-80 ms more per build (glossy 0.85 -> 0.93 s, `examples/slab_build`).
+//! 40-110 ms more per build (glossy 0.85-0.86 -> 0.93-0.96 s, `examples/slab_build`).
 
 //! **Multiple scattering on the microsurface** (`face_scattering =
 //! "multiple"`): the face the simulator has, the random walk on the Smith
