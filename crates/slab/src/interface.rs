@@ -134,8 +134,9 @@
 //! twice that on (the nodes resolve the lobe there, and averages over the
 //! cells would blur it: with every face averaged, thin tissue's
 //! transmission near the normal moved by 0.63% with twice the nodes
-//! instead of 0.39%, and GGX m = 0.9's raw transmission was 3.1e-3 from
-//! core's instead of 1.9e-3), linear between so that the face stays
+//! instead of 0.39%, and GGX m = 0.9's raw transmission from outside was
+//! 3.1e-3 from core's, above tests/rough_face.rs's 3e-3 and the 1.3e-3
+//! above), linear between so that the face stays
 //! continuous in `eta` and `m`. The same totals are now 7.5e-4 from the
 //! simulator (RMS; the largest 2.3e-3, 3.8 sigma, multiple-scattering
 //! faces at 85.5 degrees), the simulator's noise. It also lets the
