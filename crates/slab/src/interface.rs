@@ -140,8 +140,9 @@
 //! continuous in `eta` and `m`. The same totals are now 7.5e-4 from the
 //! simulator (RMS; the largest 2.3e-3, 3.8 sigma, multiple-scattering
 //! faces at 85.5 degrees), the simulator's noise. It also lets the
-//! normalisation converge for faces it could not scale before (GGX and
-//! Beckmann eta 1.05 with m 0.2 to 0.8, 1.08 from 0.05 or 0.1). About
+//! normalisation converge for faces it could not scale before (GGX eta
+//! 1.05 with m 0.5 to 0.8, Beckmann 1.05 with 0.2 to 0.8, GGX 1.08 with
+//! 0.05, Beckmann 1.08 with 0.1 to 0.3). About
 //! 40-110 ms more per build (glossy 0.85-0.86 -> 0.93-0.96 s, `examples/slab_build`).
 
 //! **Multiple scattering on the microsurface** (`face_scattering =
@@ -674,15 +675,17 @@ pub const EDGE_POINTS: usize = 4;
 /// Nodes on either side of an outside node's Snell image inside whose
 /// pairs with it hold cell averages of the transmission (module doc,
 /// "Narrow transmission lobes"): 3 took the totals of thin sheets with
-/// faces close to index-matched to the simulator's noise, 6 did no better
-/// (the probe of that section).
+/// faces close to index-matched to the simulator's noise (RMS 7.6e-4), 1
+/// left 9.6e-4, 6 did no better (8.3e-4); variants of
+/// examples/near_index_totals.rs with every face averaged, run while
+/// writing this, not kept.
 pub const SNELL_IMAGE_CELLS: usize = 3;
 
 /// Gauss-Legendre points per axis of the cell averages at the Snell
 /// image's pairs ([`SNELL_IMAGE_CELLS`]): 3 gave the totals that 4, 6 and
-/// 10 give (rms difference from the simulator 7.6e-4 for all four, 8.6e-4
-/// with 2; the probe of the module doc's "Narrow transmission lobes"), at
-/// 9 evaluations per pair and azimuth instead of 16.
+/// 10 give (RMS difference from the simulator 7.6e-4 for all four, 8.6e-4
+/// with 2; the variants of [`SNELL_IMAGE_CELLS`]'s doc), at 9 evaluations
+/// per pair and azimuth instead of 16.
 pub const SNELL_IMAGE_POINTS: usize = 3;
 
 /// The cells of a grid's first `n` nodes: `[lo, hi]` in `mu` with the

@@ -95,10 +95,9 @@ fn totals_agree_with_the_simulator() {
 
 /// Faces close to index-matched: the thin sheet of the test above with
 /// both faces so, lit on the front at the outside nodes of 0, 43.5, 75.3
-/// and 85.5 degrees, both face modes, against the simulator with the same
-/// tolerance. Some of these faces were refused until 2026-12-07 (the
-/// normalisation reached 1e-10, not 1e-12: Beckmann eta 1.12, m = 0.1; or
-/// could not scale the nodes' values at all: GGX 1.05, m = 0.3), and their
+/// and 85.5 degrees, both face modes, against the simulator. All four
+/// were refused until 2026-12-07 (the normalisation had reached 1e-10 or
+/// 1e-11, not 1e-12, in its 20,000 iterations), and their
 /// lobe around the Snell image is narrower than the nodes' cells
 /// (crates/slab/src/interface.rs, "Narrow transmission lobes"): with the
 /// nodes' values alone slab's reflectance was 4.5e-3 under the
