@@ -566,7 +566,7 @@ pub fn face_interface(
 /// (Walter's transmission in radiance transport, `f(wi, wo) / eta_o^2 =
 /// f(wo, wi) / eta_i^2`) it is `t_down`'s at the same pairs of directions
 /// over `eta^2`, `W_in T_down = (W_out T_up)^T` with `W = w mu / eta^2` as
-/// [`refraction_edge_cells`] has it (a third of the evaluations; the unit
+/// [`transmission_cell_averages`] has it (a third of the evaluations; the unit
 /// test `light_from_inside_is_reciprocal` evaluates it directly).
 fn walter_projection(bd: &RoughDielectric, outside: &Grid, inside: &Grid, orders: usize, n_phi: usize) -> Vec<Layer> {
     let rule = WalterRule::new(orders, n_phi);
@@ -582,7 +582,7 @@ fn walter_projection(bd: &RoughDielectric, outside: &Grid, inside: &Grid, orders
             })
         })
         .collect();
-    refraction_edge_cells(bd, outside, inside, &rule.phis, &rule.cos_w, &mut t_down, &mut t_up);
+    transmission_cell_averages(bd, outside, inside, &rule.phis, &rule.cos_w, &mut t_down, &mut t_up);
     r_top
         .into_iter()
         .zip(t_down)
@@ -724,16 +724,23 @@ pub fn refraction_edge_pairs(eta: f64, outside: &Grid, inside: &Grid) -> Vec<(us
         .collect()
 }
 
-/// Replaces, in both transmission blocks of Walter's projection, the node
-/// pairs whose cells the refraction edge crosses ([`refraction_edge_pairs`])
-/// by the cells' averages (module doc, "The refraction edge"): pair `(a, b)`
-/// (inside node `a`, outside node `b`) gets `1 / (w_a mu_a w_b mu_b)` times
-/// the integral of `f mu_in mu_out` over the two cells, by Gauss-Legendre
-/// in `mu_out` and in `mu_in` on the part of the cell beyond the edge, each
-/// order with the blocks' azimuth rule; the light from inside at the same
-/// pairs of directions is that over `eta^2` (reciprocity), so the blocks
-/// stay reciprocal. GGX faces only (Beckmann's `D` vanishes at the edge).
-fn refraction_edge_cells(
+/// Replaces, in both transmission blocks of Walter's projection, two sets
+/// of node pairs by the cells' averages ([`cell_averages`]):
+/// - the pairs whose cells the refraction edge crosses
+///   ([`refraction_edge_pairs`]; module doc, "The refraction edge"), wholly,
+///   with [`EDGE_POINTS`] points per axis; GGX faces only (Beckmann's `D`
+///   vanishes at the edge);
+/// - the other pairs around each node's Snell image
+///   ([`snell_image_pairs`]; module doc, "Narrow transmission lobes"), by
+///   the face's share ([`snell_image_share`]), with [`SNELL_IMAGE_POINTS`].
+///
+/// Pair `(a, b)` (inside node `a`, outside node `b`) gets `1 / (w_a mu_a
+/// w_b mu_b)` times the integral of `f mu_in mu_out` over the two cells, by
+/// Gauss-Legendre in `mu_out` and in `mu_in` on the part of the cell beyond
+/// the edge, each order with the blocks' azimuth rule; the light from
+/// inside at the same pairs of directions is that over `eta^2`
+/// (reciprocity), so the blocks stay reciprocal.
+fn transmission_cell_averages(
     bd: &RoughDielectric,
     outside: &Grid,
     inside: &Grid,
@@ -742,6 +749,31 @@ fn refraction_edge_cells(
     t_down: &mut [DMatrix<f64>],
     t_up: &mut [DMatrix<f64>],
 ) {
+    let AveragedPairs { edge, image, share } = averaged_pairs(bd, outside, inside);
+    let mut average = |pairs: &[(usize, usize)], share: f64, points: usize| {
+        cell_averages(bd, outside, inside, phis, cos_w, (pairs, share), points, t_down, t_up)
+    };
+    average(&image, share, SNELL_IMAGE_POINTS);
+    average(&edge, 1.0, EDGE_POINTS);
+}
+
+/// The transmission pairs `(a, b)` (inside node `a`, outside node `b`)
+/// that [`transmission_cell_averages`] replaces by the cells' averages.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AveragedPairs {
+    /// Those the refraction edge crosses, wholly averaged (GGX faces only:
+    /// Beckmann's `D` vanishes at the edge).
+    pub edge: Vec<(usize, usize)>,
+    /// The others around each node's Snell image, averaged by `share`
+    /// (empty where it is 0).
+    pub image: Vec<(usize, usize)>,
+    /// [`snell_image_share`] of the face.
+    pub share: f64,
+}
+
+/// Which transmission pairs of the rough face `bd` on the grids `outside`
+/// and `inside` hold cell averages, and the share of the Snell image's.
+pub fn averaged_pairs(bd: &RoughDielectric, outside: &Grid, inside: &Grid) -> AveragedPairs {
     // Beckmann's D vanishes (exponentially) at a horizontal micro-normal:
     // its transmission has no edge to integrate.
     let edge = if matches!(bd.interface, Interface::Rough(mf) if mf.dist == Distribution::Ggx) {
@@ -749,18 +781,16 @@ fn refraction_edge_cells(
     } else {
         Vec::new()
     };
-    let mut average = |pairs: &[(usize, usize)], share: f64, points: usize| {
-        cell_averages(bd, outside, inside, phis, cos_w, (pairs, share), points, t_down, t_up)
-    };
     let share = snell_image_share(bd, outside.len());
-    if share > 0.0 {
-        let image: Vec<(usize, usize)> = snell_image_pairs(outside, inside)
+    let image = if share > 0.0 {
+        snell_image_pairs(outside, inside)
             .into_iter()
             .filter(|p| !edge.contains(p))
-            .collect();
-        average(&image, share, SNELL_IMAGE_POINTS);
-    }
-    average(&edge, 1.0, EDGE_POINTS);
+            .collect()
+    } else {
+        Vec::new()
+    };
+    AveragedPairs { edge, image, share }
 }
 
 /// The share of the cell averages at the Snell image's pairs (module doc,
@@ -808,7 +838,7 @@ pub fn snell_image_pairs(outside: &Grid, inside: &Grid) -> Vec<(usize, usize)> {
 
 /// Replaces the entries of both transmission blocks at `crossed` (inside
 /// node `a`, outside node `b`) by `share` times the cells' averages of Walter's
-/// transmission ([`refraction_edge_cells`]'s doc), `points` Gauss-Legendre
+/// transmission ([`transmission_cell_averages`]'s doc), `points` Gauss-Legendre
 /// points per axis, on the part of the cells beyond the refraction edge
 /// (the whole cells where the edge does not cross them), plus `1 - share`
 /// times the entries as they were (the nodes' values).
@@ -922,7 +952,6 @@ fn normalise_face(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut [
     // Below this a node's target is nil (total internal reflection, or no
     // reflection at all): its raw column must be too, and its factor stays.
     let nil = 1e-14;
-    let mut converged = false;
     let mut worst_last = f64::INFINITY;
     for _ in 0..MAX_NORMALISATION_ITERATIONS {
         let col = |k: &DMatrix<f64>, to: &Grid, s_to: &[f64], j: usize| -> f64 {
@@ -961,11 +990,11 @@ fn normalise_face(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut [
         step(&mut a_in, &now_r_in, &r_in)?;
         worst_last = worst;
         if worst < NORMALISATION_TOLERANCE {
-            converged = true;
             break;
         }
     }
-    if !converged && worst_last > NORMALISATION_SLOW_TOLERANCE {
+    // Converged (below NORMALISATION_TOLERANCE), or slowly to what is accepted.
+    if worst_last > NORMALISATION_SLOW_TOLERANCE {
         return Err(unresolved(bd));
     }
     for layer in l.iter_mut() {
@@ -1272,11 +1301,8 @@ mod tests {
             let direct = WalterRule::new(orders, 4).block(&bd, below, false, top, true);
             // Pairs held as cell averages (the refraction edge's and the
             // Snell image's), which `cell_averages` makes reciprocal itself.
-            let mut edges = match dist {
-                Distribution::Ggx => refraction_edge_pairs(eta, top, below),
-                Distribution::Beckmann => Vec::new(),
-            };
-            edges.extend(snell_image_pairs(top, below));
+            let pairs = averaged_pairs(&bd, top, below);
+            let averaged: Vec<(usize, usize)> = pairs.edge.iter().chain(&pairs.image).copied().collect();
             // Relative to the pair's order 0 (which bounds every order of a
             // non-negative function): the high orders are sums that cancel
             // far below their terms. Measured 3e-12 to 6e-11: the two
@@ -1290,7 +1316,7 @@ mod tests {
             for (l, d) in layers.iter().zip(&direct) {
                 for o in 0..top.len() {
                     for j in 0..below.len() {
-                        if edges.contains(&(j, o)) {
+                        if averaged.contains(&(j, o)) {
                             continue;
                         }
                         let diff = (l.t_up[(o, j)] - d[(o, j)]).abs();

@@ -18,9 +18,7 @@ mod support;
 
 use paperbsdf_core::{Distribution, FaceScattering, Microfacet, RoughDielectric};
 use paperbsdf_slab::face_walk::{multiple_scattering, single_scattering};
-use paperbsdf_slab::interface::{
-    face_interface, refraction_edge_pairs, snell_image_pairs, snell_image_share, Projection,
-};
+use paperbsdf_slab::interface::{averaged_pairs, face_interface, AveragedPairs, Projection};
 use paperbsdf_slab::Grid;
 use support::layer_asymmetry;
 
@@ -66,17 +64,7 @@ fn order_one_is_walters_projection() {
         };
         let walter = face_interface(&bd, FaceScattering::Single, &out, &ins, &proj).unwrap();
         let chain = single_scattering(Microfacet::new(dist, m), 1.5, &out, &ins, 6, 8);
-        let edge = if dist == Distribution::Ggx {
-            refraction_edge_pairs(1.5, &out, &ins)
-        } else {
-            Vec::new()
-        };
-        let image = if snell_image_share(&bd, out.len()) > 0.0 {
-            snell_image_pairs(&out, &ins)
-        } else {
-            Vec::new()
-        };
-        let averaged = |a: usize, b: usize| image.contains(&(a, b)) && !edge.contains(&(a, b));
+        let AveragedPairs { edge, image, .. } = averaged_pairs(&bd, &out, &ins);
         let (mut worst, mut at_edge): (f64, f64) = (0.0, 0.0);
         for (w, c) in walter.orders.iter().zip(&chain) {
             for (a, b, down) in [
@@ -90,8 +78,8 @@ fn order_one_is_walters_projection() {
                     for j in 0..a.ncols() {
                         let d = (a[(o, j)] - b[(o, j)]).abs() / scale;
                         let (on_edge, on_image) = match down {
-                            Some(true) => (edge.contains(&(o, j)), averaged(o, j)),
-                            Some(false) => (edge.contains(&(j, o)), averaged(j, o)),
+                            Some(true) => (edge.contains(&(o, j)), image.contains(&(o, j))),
+                            Some(false) => (edge.contains(&(j, o)), image.contains(&(j, o))),
                             None => (false, false),
                         };
                         if on_image {

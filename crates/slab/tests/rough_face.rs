@@ -203,7 +203,7 @@ fn proj_raw(orders: usize, azimuth_points: usize) -> Projection {
     }
 }
 
-/// The refraction edge (crates/slab/src/interface.rs, `refraction_edge_cells`):
+/// The refraction edge (crates/slab/src/interface.rs, `transmission_cell_averages`):
 /// light from outside at `mu_out` refracts through a GGX face only into
 /// inside directions with `eta mu_in > mu_out`, where Walter's transmission
 /// jumps from `D` of a horizontal micro-normal to zero. First the premise,
