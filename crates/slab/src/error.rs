@@ -35,12 +35,12 @@ pub enum SlabError {
         step: &'static str,
     },
     /// A rough face whose projection on the grid cannot be scaled to the
-    /// face's own albedo (known for faces close to index-matched: `eta`
-    /// up to 1.03 at any roughness, to about 1.1 for smooth faces).
+    /// face's own albedo (known for faces closest to index-matched: `eta`
+    /// 1.001 with `m >= 0.1`, 1.01 with `m >= 0.8`; none from 1.02 on).
     #[error(
         "the model `slab` cannot represent the rough face of index {eta} ({dist}, m = {m}): its projection on the grid \
          did not converge to the face's albedo; `slab` does not support faces this close to index-matched yet \
-         (eta up to 1.03 whatever the roughness, up to about 1.1 for smooth faces; more nodes do not help); \
+         (eta 1.001 with m from 0.1 on, eta 1.01 with m from 0.8 on; more nodes do not help); \
          the model `paper` does"
     )]
     UnresolvedFace {
