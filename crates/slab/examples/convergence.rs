@@ -23,7 +23,9 @@
 //! (optional case names, e.g. `thin-tissue devB`: only those cases;
 //! `--nodes N`: `N` nodes and `N / 2` in the cone instead of the default's
 //! 32 and 16, against twice as many, for how the change falls with the
-//! nodes; the base build's time is printed).
+//! nodes; `--g-f G`: the forward lobe's asymmetry `g_f` of every case set
+//! to `G`; `--m M`: both faces' roughness set to `M`, 0 for smooth faces;
+//! the base build's time is printed).
 
 use paperbsdf_core::bsdf::albedo_from;
 use paperbsdf_core::geometry::in_plane_directions;
@@ -97,9 +99,34 @@ fn main() {
         base.tir_nodes = n / 2;
         only.drain(k..k + 2);
     }
+    // `--g-f G` and `--m M`: a value taken from the arguments.
+    let mut value_of = |flag: &str, range: std::ops::RangeInclusive<f64>| -> Option<f64> {
+        let k = only.iter().position(|a| a == flag)?;
+        match only.get(k + 1).map(|v| v.parse::<f64>()) {
+            Some(Ok(v)) if range.contains(&v) => {
+                only.drain(k..k + 2);
+                Some(v)
+            }
+            _ => {
+                eprintln!("{flag} needs a number in [{}, {}]", range.start(), range.end());
+                std::process::exit(2);
+            }
+        }
+    };
+    let g_f = value_of("--g-f", -0.98..=0.98);
+    let m = value_of("--m", 0.0..=1.5);
     let cases: Vec<_> = cases::cases()
         .into_iter()
         .filter(|(n, _)| only.is_empty() || only.contains(n))
+        .map(|(n, p)| {
+            let p = PaperParams {
+                g_f: g_f.unwrap_or(p.g_f),
+                m_f: m.unwrap_or(p.m_f),
+                m_b: m.unwrap_or(p.m_b),
+                ..p
+            };
+            (n, p)
+        })
         .collect();
     let variants = [
         (
