@@ -32,27 +32,18 @@
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::models::{Component, ComponentModel};
 use paperbsdf_core::{Bsdf, Colour, FaceScattering, PaperParams};
-use paperbsdf_slab::{SlabBsdf, SlabOptions};
+use paperbsdf_slab::SlabBsdf;
 
 // The cases of docs/accuracy.md, as the accuracy example has them.
 #[path = "../../sim/examples/support/cases.rs"]
 mod cases;
+#[path = "../tests/support/mod.rs"]
+mod support;
 
 /// The sheet `p` built with `k` times the default nodes (and nodes in the
 /// cone of total reflection) for each `k` of `times`.
 fn with_nodes_times(p: &PaperParams, times: &[usize]) -> Vec<SlabBsdf> {
-    let base = SlabOptions::default();
-    times
-        .iter()
-        .map(|&k| {
-            let o = SlabOptions {
-                nodes: k * base.nodes,
-                tir_nodes: k * base.tir_nodes,
-                ..base
-            };
-            SlabBsdf::with_options(p, &o).expect("build")
-        })
-        .collect()
+    times.iter().map(|&k| support::with_nodes_times(p, k)).collect()
 }
 
 /// `eval` (mean over channels) on 32, 64 and 128 nodes at `(theta_i, theta_o, transmit)`.

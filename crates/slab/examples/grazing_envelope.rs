@@ -20,10 +20,12 @@
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::models::{Component, ComponentModel};
 use paperbsdf_core::{Bsdf, FaceScattering, PaperParams};
-use paperbsdf_slab::{SlabBsdf, SlabOptions};
+use paperbsdf_slab::SlabBsdf;
 
 #[path = "../../sim/examples/support/cases.rs"]
 mod cases;
+#[path = "../tests/support/mod.rs"]
+mod support;
 
 fn table(b: &SlabBsdf, ti: f64, to: f64) -> (f64, f64) {
     let (wi, wo) = in_plane_directions(ti, to, false);
@@ -49,17 +51,8 @@ fn main() {
             face_scattering: FaceScattering::Multiple,
             ..get(name)
         };
-        let base = SlabOptions::default();
         let coarse = SlabBsdf::new(&p).expect("build");
-        let fine = SlabBsdf::with_options(
-            &p,
-            &SlabOptions {
-                nodes: 4 * base.nodes,
-                tir_nodes: 4 * base.tir_nodes,
-                ..base
-            },
-        )
-        .expect("build");
+        let fine = support::with_nodes_times(&p, 4);
         let mu = coarse.nodes().to_vec();
         let e: Vec<f64> = mu
             .iter()

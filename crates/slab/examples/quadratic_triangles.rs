@@ -23,10 +23,12 @@
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::models::{Component, ComponentModel};
 use paperbsdf_core::{Bsdf, FaceScattering, PaperParams};
-use paperbsdf_slab::{SlabBsdf, SlabOptions};
+use paperbsdf_slab::SlabBsdf;
 
 #[path = "../../sim/examples/support/cases.rs"]
 mod cases;
+#[path = "../tests/support/mod.rs"]
+mod support;
 
 /// The whole value and the table's part (less the surface lobe in reflection).
 fn table(b: &SlabBsdf, ti: f64, to: f64, tr: bool) -> (f64, f64) {
@@ -109,17 +111,8 @@ fn main() {
             face_scattering: fs,
             ..get(name)
         };
-        let base = SlabOptions::default();
         let coarse = SlabBsdf::new(&p).expect("build");
-        let fine = SlabBsdf::with_options(
-            &p,
-            &SlabOptions {
-                nodes: 4 * base.nodes,
-                tir_nodes: 4 * base.tir_nodes,
-                ..base
-            },
-        )
-        .expect("build");
+        let fine = support::with_nodes_times(&p, 4);
         let mu = coarse.nodes().to_vec();
         let n = mu.len() as isize;
         let theta = |k: isize| mu[k as usize].acos().to_degrees();

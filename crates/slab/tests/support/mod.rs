@@ -1,7 +1,7 @@
 //! What the slab crate's integration tests share: the reciprocity measure of
 //! a layer's matrices, the simulator's totals for collimated light, a
 //! deterministic rule for the integral of a BSDF over the outgoing
-//! direction, a sheet built with the default and with twice the nodes, and
+//! direction, a sheet built with the default and with `k` times the nodes, and
 //! the directions around the lobes of `two_crossings` ([`lobe_points`]),
 //! and a sheet given two alike faces ([`with_both_faces`]).
 #![allow(dead_code)]
@@ -91,23 +91,26 @@ pub fn grid_albedo(f: impl Fn(DVec3) -> f64, nodes: &[f64], mu_i: f64, per: usiz
     total
 }
 
+/// The model `slab` of `p` with the default options but `k` times their
+/// nodes (outside and in the cone of total reflection).
+pub fn with_nodes_times(p: &paperbsdf_core::PaperParams, k: usize) -> paperbsdf_slab::SlabBsdf {
+    use paperbsdf_slab::{SlabBsdf, SlabOptions};
+    let base = SlabOptions::default();
+    let o = SlabOptions {
+        nodes: k * base.nodes,
+        tir_nodes: k * base.tir_nodes,
+        ..base
+    };
+    SlabBsdf::with_options(p, &o).unwrap()
+}
+
 /// The model `slab` of `p` with the default options and with twice the
 /// nodes (outside and in the cone of total reflection): the pair the
 /// issue's convergence criterion compares.
 pub fn default_and_doubled_nodes(
     p: &paperbsdf_core::PaperParams,
 ) -> (paperbsdf_slab::SlabBsdf, paperbsdf_slab::SlabBsdf) {
-    use paperbsdf_slab::{SlabBsdf, SlabOptions};
-    let base = SlabOptions::default();
-    let doubled = SlabOptions {
-        nodes: 2 * base.nodes,
-        tir_nodes: 2 * base.tir_nodes,
-        ..base
-    };
-    (
-        SlabBsdf::with_options(p, &base).unwrap(),
-        SlabBsdf::with_options(p, &doubled).unwrap(),
-    )
+    (with_nodes_times(p, 1), with_nodes_times(p, 2))
 }
 
 /// `p` with both faces of index `eta`, roughness `m` and distribution
