@@ -85,7 +85,8 @@
 //! `normalise_face`). For Beckmann, core's
 //! albedo uses the exact Smith `G1` of the incident direction where
 //! `eval_mode` uses Walter's rational approximation (below 0.35% apart,
-//! `paperbsdf_core::microsurface`); the normalisation follows the former.
+//! `paperbsdf_core::microsurface`); the normalisation follows the latter
+//! ([`walter_albedo`], since 2026-12-07), the face the simulator samples.
 //!
 //! **The refraction edge.** Light from outside at `mu_out` refracts into the
 //! medium only at directions with `eta mu_in > mu_out`: beyond, the
@@ -912,6 +913,41 @@ fn cell_averages(
     }
 }
 
+/// `(R, T)` of Walter's face as [`RoughDielectric::eval_mode`] has it, for
+/// light arriving from `w`: core's quadrature in the square of visible
+/// normals (`directional_albedo_rule` on `rule`) times `G1(w) / G1_exact(w)`.
+///
+/// Core's quadrature weighs the micro-normals by the distribution of
+/// visible normals, whose normalisation holds the exact Smith `G1` of `w`
+/// (`Microfacet::g1_exact`), and the outgoing direction by
+/// `Microfacet::g1`; `eval_mode` has `Microfacet::g1` for both, which for
+/// Beckmann is Walter's rational approximation (`paperbsdf_core::microfacet`).
+/// The incident direction's `G1` is a factor of the whole lobe, so the
+/// ratio turns the one albedo into the other exactly. For GGX the two are
+/// the same function (ratio 1). The simulator's face is `eval_mode`'s (its
+/// sampling weights `eval_mode / pdf`), and so is the analytic lobe of
+/// the model `slab`; until 2026-12-07 the normalisation took core's albedo,
+/// up to 0.35% apart at grazing incidence: a thin sheet with Beckmann
+/// faces (`eta` 1.1, `m` 0.05) lost 2.1e-3 of its `R + T` at 85.5 degrees
+/// against the simulator (2.9e-3 at 86.1 on 64 nodes), what the two
+/// albedos of its face differ by there (tests/rough_face.rs,
+/// `normalisation_targets_are_walters_own_albedo`).
+pub fn walter_albedo(bd: &RoughDielectric, w: DVec3, rule: &(Vec<f64>, Vec<f64>)) -> (f64, f64) {
+    let (r, t) = directional_albedo_rule(bd, w, rule);
+    let ratio = match bd.interface {
+        Interface::Rough(mf) if mf.dist == Distribution::Beckmann => {
+            let exact = mf.g1_exact(w, DVec3::Z);
+            if exact > 0.0 {
+                mf.g1(w, DVec3::Z) / exact
+            } else {
+                1.0
+            }
+        }
+        _ => 1.0,
+    };
+    (r * ratio, t * ratio)
+}
+
 /// Scales every order of Walter's projected face `l` so that the order-0
 /// albedos of every node match core's quadrature of the face (module doc):
 /// from outside `R + T` (factors `s_o s_j` on `r_top`, `s_o s_j` on the
@@ -940,7 +976,7 @@ fn normalise_face(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut [
     let rule = gauss_legendre_01(ALBEDO_POINTS);
     let target = |g: &Grid, side: f64| -> Vec<(f64, f64)> {
         g.mu.par_iter()
-            .map(|&mu| directional_albedo_rule(bd, dir_at_mu(mu, side), &rule))
+            .map(|&mu| walter_albedo(bd, dir_at_mu(mu, side), &rule))
             .collect()
     };
     let t_out: Vec<f64> = target(outside, 1.0).iter().map(|(r, t)| r + t).collect();

@@ -109,7 +109,10 @@ fn totals_agree_with_the_simulator() {
 /// 1.05 with 1.3 (a corner of the fit's bounds) were refused until Newton's
 /// method finished the normalisation (crates/slab/src/interface.rs,
 /// `newton_scaling`, 2026-12-07); with them, and five more faces built
-/// since then, the same example's RMS is 9.1e-4 over 56 totals.
+/// since then, the same example's RMS is 8.2e-4 over 56 totals (9.1e-4
+/// before the normalisation took the face's own albedo,
+/// `interface::walter_albedo`; the first set's 7.5e-4 and 2.3e-3 then
+/// 7.5e-4 and 2.1e-3).
 ///
 /// **Tolerance** `3 sigma + 1.5e-3` ([`NEAR_INDEX_TOLERANCE`]), half the
 /// test above's: these faces reflect little (Fresnel 3.2e-3 at normal
