@@ -1107,11 +1107,9 @@ const NEWTON_STEPS: usize = 60;
 /// iterations). Newton's step takes that direction in one solve.
 fn newton_scaling(a: &DMatrix<f64>, target: &[f64], v: &mut [f64], nil: f64) -> f64 {
     let n = v.len();
-    let albedos = |v: &[f64]| -> Vec<f64> {
-        (0..n)
-            .map(|e| v[e] * (0..n).map(|k| a[(e, k)] * v[k]).sum::<f64>())
-            .collect()
-    };
+    // `S_e` for every equation, and the albedos `v_e S_e`.
+    let sums = |v: &[f64]| -> Vec<f64> { (0..n).map(|e| (0..n).map(|k| a[(e, k)] * v[k]).sum()).collect() };
+    let albedos = |v: &[f64]| -> Vec<f64> { sums(v).iter().zip(v).map(|(s, x)| x * s).collect() };
     let active: Vec<usize> = {
         let now = albedos(v);
         (0..n).filter(|&e| !(target[e] <= nil && now[e] <= nil)).collect()
@@ -1138,10 +1136,10 @@ fn newton_scaling(a: &DMatrix<f64>, target: &[f64], v: &mut [f64], nil: f64) -> 
             break;
         }
         let m = active.len();
-        let sums: Vec<f64> = active.iter().map(|&e| (0..n).map(|k| a[(e, k)] * v[k]).sum()).collect();
+        let s = sums(v);
         let jac = DMatrix::from_fn(m, m, |r, c| {
             let (e, k) = (active[r], active[c]);
-            f64::from(u8::from(r == c)) + a[(e, k)] * v[k] / sums[r]
+            f64::from(u8::from(r == c)) + a[(e, k)] * v[k] / s[e]
         });
         let rhs = nalgebra::DVector::from_iterator(m, f.iter().map(|x| -x));
         let Some(dx) = jac.lu().solve(&rhs) else {

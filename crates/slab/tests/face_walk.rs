@@ -16,7 +16,8 @@
 
 mod support;
 
-use paperbsdf_core::boundary::{dir_at_mu, directional_albedo_n};
+use paperbsdf_core::boundary::{dir_at_mu, directional_albedo_rule};
+use paperbsdf_core::quadrature::gauss_legendre_01;
 use paperbsdf_core::{Distribution, FaceScattering, Microfacet, RoughDielectric};
 use paperbsdf_slab::face_walk::{multiple_scattering, single_scattering};
 use paperbsdf_slab::interface::{averaged_pairs, face_interface, AveragedPairs, Projection};
@@ -110,6 +111,7 @@ fn order_one_is_walters_projection() {
 #[test]
 fn discretised_walk_returns_what_walter_loses() {
     let (out, ins) = grids(1.5, 32);
+    let rule = gauss_legendre_01(128);
     for (dist, m) in [
         (Distribution::Ggx, 0.3),
         (Distribution::Ggx, 0.6),
@@ -130,7 +132,7 @@ fn discretised_walk_returns_what_walter_loses() {
         let core_lost = |g: &Grid, side: f64| -> Vec<f64> {
             g.mu.iter()
                 .map(|&mu| {
-                    let (r, t) = directional_albedo_n(&bd, dir_at_mu(mu, side), 128);
+                    let (r, t) = directional_albedo_rule(&bd, dir_at_mu(mu, side), &rule);
                     1.0 - r - t
                 })
                 .collect()

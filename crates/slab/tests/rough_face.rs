@@ -65,14 +65,15 @@ fn grids(eta: f64, nodes: usize) -> (Grid, Grid) {
     (out, ins)
 }
 
-/// Core's `(R, T)` at every outside node (from outside) and inside node (from inside).
-/// Core's `(R, T)` from outside at the outside nodes and from inside at the inside nodes.
+/// Walter's face's `(R, T)` as `eval_mode` has it (`walter_albedo` on core's
+/// rule) from outside at the outside nodes and from inside at the inside nodes.
 type References = (Vec<(f64, f64)>, Vec<(f64, f64)>);
 
 fn references(bd: &RoughDielectric, out: &Grid, ins: &Grid) -> References {
+    let rule = gauss_legendre_01(REFERENCE_POINTS);
     let at = |g: &Grid, side: f64| -> Vec<(f64, f64)> {
         g.mu.iter()
-            .map(|&mu| walter_albedo(bd, dir_at_mu(mu, side), &gauss_legendre_01(REFERENCE_POINTS)))
+            .map(|&mu| walter_albedo(bd, dir_at_mu(mu, side), &rule))
             .collect()
     };
     (at(out, 1.0), at(ins, -1.0))
