@@ -1192,8 +1192,9 @@ pub(crate) fn scale_rows_cols(k: &mut DMatrix<f64>, rows: &[f64], cols: &[f64]) 
 /// day) every face with `eta <= 1.03` but one was refused, and some up to
 /// 1.1, and more nodes did not help (128 for eta 1.05, 2026-12-06). Now
 /// more nodes let some through: GGX 1.001 with `m` 0.1 and Beckmann 1.01
-/// with 0.8 from 64 nodes, GGX 1.001 with 0.3 from 128, not GGX 1.01 with
-/// 1.2 at 128 (a probe building each, 2026-12-07, not kept).
+/// with 0.8 and 1.2 from 64 nodes, GGX 1.001 with 0.2 to 0.8 and Beckmann
+/// 1.001 with 0.2 and 0.3 from 128; not GGX 1.001 or 1.01 with 1.2 nor
+/// Beckmann 1.001 from 0.5 (examples/near_index_support.rs, `--more-nodes`).
 fn unresolved(bd: &RoughDielectric) -> SlabError {
     SlabError::UnresolvedFace {
         eta: bd.eta,
