@@ -1064,13 +1064,13 @@ fn normalise_face(bd: &RoughDielectric, outside: &Grid, inside: &Grid, l: &mut [
         let a = DMatrix::from_fn(no + ni, no + ni, coupled);
         let want: Vec<f64> = t_out.iter().chain(&t_in).copied().collect();
         let mut v: Vec<f64> = s_out.iter().chain(&s_in).copied().collect();
-        let worst_t = newton_scaling(&a, &want, &mut v, nil);
+        let worst_t = newton_scaling(&a, &want, &mut v, nil, NORMALISATION_TOLERANCE);
         s_out.copy_from_slice(&v[..no]);
         s_in.copy_from_slice(&v[no..]);
         let a_r = DMatrix::from_fn(ni, ni, |e, k| {
             inside.w[k] * inside.mu[k] * l0.r_bot[(k, e)] / (inside.w[e] * inside.mu[e])
         });
-        let worst_r = newton_scaling(&a_r, &r_in, &mut a_in, nil);
+        let worst_r = newton_scaling(&a_r, &r_in, &mut a_in, nil, NORMALISATION_TOLERANCE);
         worst_last = worst_t.max(worst_r);
     }
     // Converged (below NORMALISATION_TOLERANCE), or to what is accepted.
@@ -1093,10 +1093,13 @@ const NEWTON_STEPS: usize = 60;
 /// `S_e = sum_k a[(e, k)] v_k` (every node's albedo `now_e = v_e S_e` at
 /// its target `t_e`), in the logarithms of the factors: `F_e = ln(now_e /
 /// t_e)`, Jacobian `dF_e / d ln v_k = [e = k] + a[(e, k)] v_k / S_e`,
-/// solved by LU, each step halved until `sum F^2` falls. The equations
+/// solved by LU, each step halved until `sum F^2` falls, until every
+/// albedo is within `tolerance` of its target. The equations
 /// whose target and albedo are both below `nil` are left out (their
 /// factor held), as in the square-root iteration. Returns the largest
 /// `|now_e / t_e - 1|` reached (infinite where an albedo is not positive).
+/// The faces' normalisation ([`normalise_face`]) and the walk's scaling to
+/// the energy the face loses (`crate::face_walk`) finish with it.
 ///
 /// The square-root iteration (`v_e *= sqrt(t_e / now_e)`) slows to a
 /// crawl where the system is nearly degenerate: a face close to
@@ -1105,7 +1108,7 @@ const NEWTON_STEPS: usize = 60;
 /// only through their products, and its weak reflection pins them apart
 /// (GGX `eta` 1.05, `m` 1.3 was 2.2e-6 from its targets after 20,000
 /// iterations). Newton's step takes that direction in one solve.
-fn newton_scaling(a: &DMatrix<f64>, target: &[f64], v: &mut [f64], nil: f64) -> f64 {
+pub(crate) fn newton_scaling(a: &DMatrix<f64>, target: &[f64], v: &mut [f64], nil: f64, tolerance: f64) -> f64 {
     let n = v.len();
     // `S_e` for every equation, and the albedos `v_e S_e`.
     let sums = |v: &[f64]| -> Vec<f64> { (0..n).map(|e| (0..n).map(|k| a[(e, k)] * v[k]).sum()).collect() };
@@ -1132,7 +1135,7 @@ fn newton_scaling(a: &DMatrix<f64>, target: &[f64], v: &mut [f64], nil: f64) -> 
         return f64::INFINITY;
     };
     for _ in 0..NEWTON_STEPS {
-        if worst < NORMALISATION_TOLERANCE {
+        if worst < tolerance {
             break;
         }
         let m = active.len();
@@ -1538,7 +1541,7 @@ mod tests {
             .map(|e| v_star[e] * (0..big).map(|k| a[(e, k)] * v_star[k]).sum::<f64>())
             .collect();
         let mut v = vec![1.0; big];
-        let worst = newton_scaling(&a, &target, &mut v, 1e-14);
+        let worst = newton_scaling(&a, &target, &mut v, 1e-14, NORMALISATION_TOLERANCE);
         assert!(worst < NORMALISATION_TOLERANCE, "Newton's method left {worst:e}");
         let off = v
             .iter()
