@@ -18,7 +18,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2,
 use paperbsdf_core::models::ModelKind;
 use paperbsdf_core::paper::Component;
 use paperbsdf_core::{BsdfFlags, DVec3, PaperParams, Rgb};
-use paperbsdf_io::models::{load_model, load_model_text, LoadedModel};
+use paperbsdf_io::models::{load_model, load_model_text_with, LoadedModel, SlabSettings};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -149,12 +149,24 @@ fn parse_component(component: &str) -> PyResult<Option<Component>> {
 
 #[pymethods]
 impl Model {
-    /// `Model(name, text, origin, is_toml)`: the model `name` from the text of
-    /// a parameter set (JSON, or TOML when `is_toml`); `origin` names it in errors.
+    /// `Model(name, text, origin, is_toml, slab_nodes=None)`: the model
+    /// `name` from the text of a parameter set (JSON, or TOML when
+    /// `is_toml`); `origin` names it in errors. `slab_nodes`: nodes per
+    /// hemisphere of the model `slab` (`paperbsdf eval --slab-nodes`;
+    /// `None` for the default 32, an error for other models).
     #[new]
-    fn new(py: Python<'_>, name: &str, text: &str, origin: &str, is_toml: bool) -> PyResult<Self> {
+    #[pyo3(signature = (name, text, origin, is_toml, slab_nodes = None))]
+    fn new(
+        py: Python<'_>,
+        name: &str,
+        text: &str,
+        origin: &str,
+        is_toml: bool,
+        slab_nodes: Option<usize>,
+    ) -> PyResult<Self> {
+        let settings = SlabSettings { nodes: slab_nodes };
         let model = py
-            .detach(|| load_model_text(name, text, origin, is_toml))
+            .detach(|| load_model_text_with(name, text, origin, is_toml, &settings, "slab_nodes"))
             .map_err(|e| value_error(e.to_string()))?;
         Ok(Model {
             model,

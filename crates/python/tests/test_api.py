@@ -49,13 +49,13 @@ UNEQUAL = {  # unequal faces, RGB coefficients, a Beckmann back face
 }
 
 
-def cli_eval(cli, model, params_arg, wi, wo, tmp_path):
+def cli_eval(cli, model, params_arg, wi, wo, tmp_path, extra=()):
     path = tmp_path / "dirs.csv"
     with open(path, "w") as f:
         f.write("wi_x,wi_y,wi_z,wo_x,wo_y,wo_z\n")
         for a, b in zip(wi, wo):
             f.write(",".join(repr(float(x)) for x in (*a, *b)) + "\n")
-    out = subprocess.run([cli, "eval", "--model", model, "--params", params_arg, "--dirs", str(path)],
+    out = subprocess.run([cli, "eval", "--model", model, "--params", params_arg, "--dirs", str(path), *extra],
                          check=True, capture_output=True, text=True).stdout
     rows = [l.split(",") for l in out.strip().splitlines()[1:]]
     vals = np.array([[float(x) for x in r[6:]] for r in rows])
@@ -84,6 +84,28 @@ def test_eval_matches_cli(cli, tmp_path, model, params):
     scale = np.maximum(np.abs(theirs), 1e-300)
     rel = np.abs(ours - theirs) / scale
     assert rel.max() <= 1e-12, f"worst relative difference {rel.max():.3e}"
+
+
+def test_slab_nodes_match_cli(cli, tmp_path):
+    # `slab_nodes` is the CLI's `--slab-nodes`: the same values to 1e-12 on
+    # the hard pairs, and not the default's (16 nodes move luster's values by
+    # up to about 1%, more than rounding); out of range, of the wrong type or
+    # for another model it is a ValueError naming it.
+    wi, wo = hard_pairs()
+    coarse = paperbsdf.Bsdf("slab", "luster", slab_nodes=16)
+    ours = coarse.eval(wi, wo)
+    theirs = cli_eval(cli, "slab", json.dumps(paperbsdf.preset("luster")), wi, wo, tmp_path, ("--slab-nodes", "16"))
+    scale = np.maximum(np.abs(theirs), 1e-300)
+    assert (np.abs(ours - theirs) / scale).max() <= 1e-12
+    base = paperbsdf.Bsdf("slab", "luster").eval(wi, wo)
+    assert np.abs(ours - base).max() > 1e-6 * np.abs(base).max()
+    for bad, parts in [(300, ["slab_nodes", "300", "[2, 256]"]), (1, ["slab_nodes", "[2, 256]"]),
+                       (-3, ["slab_nodes", "[2, 256]"]), ("64", ["slab_nodes"]), (True, ["slab_nodes"])]:
+        with pytest.raises(ValueError) as e:
+            paperbsdf.Bsdf("slab", "luster", slab_nodes=bad)
+        assert all(p in str(e.value) for p in parts), str(e.value)
+    with pytest.raises(ValueError, match="slab_nodes.*paper"):
+        paperbsdf.Bsdf("paper", "matte", slab_nodes=64)
 
 
 def test_components_sum_to_all():

@@ -254,6 +254,14 @@ def test_load_dict_errors():
     err({"preset": "matte", "params": "{}"}, r"either `params` or `preset`")
     err({}, r"give the property `params`")
     err({"model": "plastic", "params": json.dumps(p)}, r"unknown model `plastic`")
+    err({"preset": "matte", "slab_nodes": 64}, r"slab_nodes.*`paper` has none")
+    err({"model": "slab", "params": json.dumps(p), "slab_nodes": 300}, r"slab_nodes: 300 .*\[2, 256\]")
+    # A valid `slab_nodes` reaches the model: the plugin's values are those of
+    # the Python model with the same nodes, not the default's.
+    plugin = mi.load_dict({"type": "paperbsdf", "model": "slab", "params": json.dumps(p), "slab_nodes": 16})
+    wi, wo = np.array([[0.5, 0.0, np.sqrt(0.75)]]), np.array([[-0.9, 0.0, np.sqrt(0.19)]])
+    assert plugin.model.eval(wi, wo)[0, 0] == paperbsdf.Bsdf("slab", p, slab_nodes=16).eval(wi, wo)[0, 0]
+    assert plugin.model.eval(wi, wo)[0, 0] != paperbsdf.Bsdf("slab", p).eval(wi, wo)[0, 0]
 
 
 @pytest.mark.parametrize("mode", ["native", "exact"])

@@ -83,8 +83,9 @@ impl HitBsdf<'_> {
     }
 }
 
-/// Builds a Paper BSDF from parameters (the core model; see [`crate::paper_model`]).
-pub type PaperFactory = fn(&PaperParams) -> Result<Arc<dyn Bsdf>, paperbsdf_core::ParamError>;
+/// Builds a sheet's BSDF from parameters: the core model or the model
+/// `slab` with its discretisation ([`crate::paper_model`]).
+pub type PaperFactory = Arc<dyn Fn(&PaperParams) -> Result<Arc<dyn Bsdf>, paperbsdf_core::ParamError> + Send + Sync>;
 
 /// A greyscale map that scales the sheet's thickness: `d(uv) = d (min + (1 - min) grey(uv))`.
 #[derive(Clone, Debug)]

@@ -16,7 +16,13 @@ pub fn paper_bsdf(p: &PaperParams) -> Result<Arc<dyn Bsdf>, ParamError> {
 /// (`paperbsdf_slab::SlabBsdf`); its errors as parameter errors (the
 /// parameter's name and range, or `model` for what the solver does not support).
 pub fn slab_bsdf(p: &PaperParams) -> Result<Arc<dyn Bsdf>, ParamError> {
-    match paperbsdf_slab::SlabBsdf::new(p) {
+    slab_bsdf_with(p, &paperbsdf_slab::SlabOptions::default())
+}
+
+/// [`slab_bsdf`] with the solver's discretisation `options` (a material's
+/// `slab_nodes`).
+pub fn slab_bsdf_with(p: &PaperParams, options: &paperbsdf_slab::SlabOptions) -> Result<Arc<dyn Bsdf>, ParamError> {
+    match paperbsdf_slab::SlabBsdf::with_options(p, options) {
         Ok(b) => Ok(Arc::new(b)),
         Err(paperbsdf_slab::SlabError::Param(e)) => Err(e),
         Err(e) => Err(ParamError::Invalid {

@@ -40,7 +40,7 @@ pub enum SlabError {
     #[error(
         "the model `slab` cannot represent the rough face of index {eta} ({dist}, m = {m}): its projection on the grid \
          did not converge to the face's albedo; `slab` does not support faces this close to index-matched yet \
-         (eta 1.001 with m from 0.1 on, eta 1.01 with m from 0.8 on; more nodes, `SlabOptions::nodes` 64 or 128, let some of them through); \
+         (eta 1.001 with m from 0.1 on, eta 1.01 with m from 0.8 on; more nodes let some of them through: 64 or 128 with `--slab-nodes`, `slab_nodes` or `SlabOptions::nodes`); \
          the model `paper` does"
     )]
     UnresolvedFace {

@@ -101,6 +101,10 @@ pub struct PaperSpec {
     /// The model that renders the sheet: `"paper"` (default) or `"slab"`.
     #[serde(skip_serializing)]
     pub model: Option<SheetModel>,
+    /// With `model = "slab"`: the nodes per hemisphere of its
+    /// discretisation, 2 to 256 (default 32; `paperbsdf eval --slab-nodes`).
+    #[serde(skip_serializing)]
+    pub slab_nodes: Option<usize>,
 }
 
 /// The model of a `type = "paper"` material (docs/design.md 4.7).

@@ -271,8 +271,20 @@ fn material(name: &str, m: &MaterialSpec, file: &str, res: &Resources) -> Result
                 }
             };
             let factory: crate::material::PaperFactory = match m.model.unwrap_or_default() {
-                SheetModel::Paper => paper_model::paper_bsdf,
-                SheetModel::Slab => paper_model::slab_bsdf,
+                SheetModel::Paper => {
+                    if m.slab_nodes.is_some() {
+                        return Err(at.err(
+                            "`slab_nodes` sets the discretisation of `model = \"slab\"`; the model `paper` has none",
+                        ));
+                    }
+                    Arc::new(paper_model::paper_bsdf)
+                }
+                SheetModel::Slab => {
+                    let options = paperbsdf_io::models::SlabSettings { nodes: m.slab_nodes }
+                        .options("slab_nodes")
+                        .map_err(|e| at.err(e))?;
+                    Arc::new(move |p: &PaperParams| paper_model::slab_bsdf_with(p, &options))
+                }
             };
             let pm = PaperMaterial::new(p, thickness, ink, factory).map_err(|e| at.err(e))?;
             Material::Paper(Box::new(pm))
