@@ -2156,7 +2156,13 @@ fn fourier_sum_with<const K: usize, const FMA: bool>(
             let (data, l, h) = tab.pair::<K>(st, p);
             if let Some(samples) = if l > h { tab.samples(st, p, l, h) } else { None } {
                 if phi.is_nan() {
-                    phi = c.acos();
+                    // fdlibm's `acos` (the `libm` crate, within 1 ulp):
+                    // glibc's, correctly rounded, was 10% of matte's `eval`
+                    // at grazing angles, where these pairs are (perf on
+                    // examples/sample_cost.rs; criterion `eval_grazing`
+                    // 189 -> 182 ns, luster 167 -> 160, glossy 180-186 ->
+                    // 171, thin tissue 153 -> 146, 2026-12-07).
+                    phi = libm::acos(c);
                 }
                 let v = samples.at::<K>(phi, &data[K * h + l - h..]);
                 for (a, x) in acc.iter_mut().zip(v) {
@@ -3593,7 +3599,8 @@ impl SlabBsdf {
         let h = usize::from(wi.z * wo.z <= 0.0);
         let k = ((wi.z.abs() * self.mu_bins as f64) as usize).min(self.mu_bins - 1);
         let dphi = PI / self.phi_bins as f64;
-        let phi = c.acos();
+        // libm's (fdlibm's) `acos`, as `fourier_sum_with`'s.
+        let phi = libm::acos(c);
         let x = phi / dphi;
         let b = (x as usize).min(self.phi_bins - 1);
         let x = x - b as f64;
