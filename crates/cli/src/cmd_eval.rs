@@ -7,7 +7,25 @@ use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::{DVec3, Rgb};
 use paperbsdf_io::angles::check_angles;
 use paperbsdf_io::dirs::csv_line;
-use paperbsdf_io::models::{load_model_with, SlabSettings};
+use paperbsdf_io::models::{load_model_with, LoadedModel, SlabSettings};
+use paperbsdf_io::DataError;
+
+/// `--slab-nodes`, shared by the commands that load a model (`eval`,
+/// `albedo`, `measure`).
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct SlabArgs {
+    /// Nodes per hemisphere of the model `slab`'s discretisation (default 32; 64 converges its values to within 0.2% of twice the nodes on the accuracy cases but one, and builds about 4 times slower). Only with --model slab.
+    #[arg(long = "slab-nodes")]
+    pub slab_nodes: Option<usize>,
+}
+
+impl SlabArgs {
+    /// Loads model `name` with parameters from `params` and this
+    /// discretisation (an error for a model other than `slab`).
+    pub fn load(&self, name: &str, params: &str) -> Result<LoadedModel, DataError> {
+        load_model_with(name, params, &SlabSettings { nodes: self.slab_nodes }, "--slab-nodes")
+    }
+}
 
 /// Arguments of `paperbsdf eval`.
 #[derive(clap::Args, Debug)]
@@ -27,9 +45,8 @@ pub struct EvalArgs {
     /// In-plane viewing angles: one angle, or FROM:TO:STEP, in degrees (signed; negative is opposite the light).
     #[arg(long = "theta-o", allow_hyphen_values = true)]
     pub theta_o: Option<String>,
-    /// Nodes per hemisphere of the model `slab`'s discretisation (default 32; 64 converges its values to within 0.2% of twice the nodes on the accuracy cases but one, and builds about 4 times slower). Only with --model slab.
-    #[arg(long = "slab-nodes")]
-    pub slab_nodes: Option<usize>,
+    #[command(flatten)]
+    pub slab: SlabArgs,
     /// Which component to evaluate (a component the model lacks is an error).
     #[arg(long, default_value = "all", value_parser = choices::component(), ignore_case = true)]
     pub component: ComponentChoice,
@@ -56,9 +73,8 @@ pub struct AlbedoArgs {
     /// Which face the light arrives at.
     #[arg(long, value_enum, default_value_t = Side::Front, ignore_case = true)]
     pub side: Side,
-    /// Nodes per hemisphere of the model `slab`'s discretisation (default 32; 64 converges its values to within 0.2% of twice the nodes on the accuracy cases but one, and builds about 4 times slower). Only with --model slab.
-    #[arg(long = "slab-nodes")]
-    pub slab_nodes: Option<usize>,
+    #[command(flatten)]
+    pub slab: SlabArgs,
 }
 
 /// `albedo --side`: the face the light arrives at.
@@ -106,12 +122,7 @@ pub fn run_eval(a: EvalArgs) -> Result<()> {
     if let Some(out) = &a.out {
         paperbsdf_io::check_output_path(out, "--out")?;
     }
-    let model = load_model_with(
-        &a.model,
-        &a.params,
-        &SlabSettings { nodes: a.slab_nodes },
-        "--slab-nodes",
-    )?;
+    let model = a.slab.load(&a.model, &a.params)?;
     let component = a.component.0;
     // Before any output.
     model.check_component(component)?;
@@ -151,12 +162,7 @@ pub fn run_eval(a: EvalArgs) -> Result<()> {
 
 /// Runs `paperbsdf albedo`.
 pub fn run_albedo(a: AlbedoArgs) -> Result<()> {
-    let model = load_model_with(
-        &a.model,
-        &a.params,
-        &SlabSettings { nodes: a.slab_nodes },
-        "--slab-nodes",
-    )?;
+    let model = a.slab.load(&a.model, &a.params)?;
     let sign = match a.side {
         Side::Front => 1.0,
         Side::Back => -1.0,

@@ -7,7 +7,7 @@
 use anyhow::{bail, Context, Result};
 use paperbsdf_core::models::ModelKind;
 use paperbsdf_core::PaperParams;
-use paperbsdf_io::models::{load_model_with, LoadedModel, SlabSettings};
+use paperbsdf_io::models::LoadedModel;
 use paperbsdf_metrics::edge::{model_edge, truth_edge, EdgeProfile, ScatterDistance, SUPPLEMENT_BLUR_MM};
 use paperbsdf_metrics::instrument::Quality;
 use paperbsdf_metrics::{
@@ -23,9 +23,8 @@ pub struct MeasureArgs {
     /// Model name: paper, reduced-multilayer, slab, lambert-glass, rough-dielectric.
     #[arg(long, default_value = "paper")]
     pub model: String,
-    /// Nodes per hemisphere of the model `slab`'s discretisation (default 32; 64 converges its values to within 0.2% of twice the nodes on the accuracy cases but one, and builds about 4 times slower). Only with --model slab.
-    #[arg(long = "slab-nodes")]
-    pub slab_nodes: Option<usize>,
+    #[command(flatten)]
+    pub slab: crate::cmd_eval::SlabArgs,
     /// Print JSON (keys as in docs/paper_metrics.md) instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -144,7 +143,7 @@ pub fn run_measure(a: MeasureArgs) -> Result<()> {
                 a.model
             );
         }
-        if a.slab_nodes.is_some() {
+        if a.slab.slab_nodes.is_some() {
             bail!("--slab-nodes sets the discretisation of the model `slab`; --truth simulates the sheet instead");
         }
         let p = paper_params(&a.params)?;
@@ -158,12 +157,7 @@ pub fn run_measure(a: MeasureArgs) -> Result<()> {
         };
         measure_truth(&p, a.grammage, &sel, &cfg).map_err(anyhow::Error::msg)?
     } else {
-        let model = load_model_with(
-            &a.model,
-            &a.params,
-            &SlabSettings { nodes: a.slab_nodes },
-            "--slab-nodes",
-        )?;
+        let model = a.slab.load(&a.model, &a.params)?;
         let params = match &model {
             LoadedModel::Paper(_) => Some(paper_params(&a.params)?),
             _ => None,

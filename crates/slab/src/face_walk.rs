@@ -438,13 +438,9 @@ pub fn multiple_scattering(
     let target: Vec<f64> = lost_all.iter().zip(&unresolved).map(|(t, u)| t - u).collect();
     let (t_out, t_in) = target.split_at(no);
     let scale = symmetric_scaling(&layers[0], outside, inside, t_out, t_in)?;
-    let (s_out, s_in) = scale.split_at(no);
     let mut layers = layers;
     for l in layers.iter_mut() {
-        scale_rows_cols(&mut l.r_top, s_out, s_out);
-        scale_rows_cols(&mut l.t_down, s_in, s_out);
-        scale_rows_cols(&mut l.r_bot, s_in, s_in);
-        scale_rows_cols(&mut l.t_up, s_out, s_in);
+        scale_layer(l, &scale, no);
     }
     let share = |t: &DMatrix<f64>, from: &Grid, to: &Grid, lost: &[f64]| -> f64 {
         let total: f64 = (0..from.len()).map(|j| from.w[j] * from.mu[j] * lost[j]).sum();
@@ -612,6 +608,16 @@ fn symmetric_scaling(l: &Layer, top: &Grid, bot: &Grid, t_out: &[f64], t_in: &[f
     }
 }
 
+/// Scales `l`'s blocks by the factors `s` of its nodes (the `no` outside
+/// nodes, then the inside ones): `K[o][j] s_o s_j`.
+fn scale_layer(l: &mut Layer, s: &[f64], no: usize) {
+    let (s_out, s_in) = s.split_at(no);
+    scale_rows_cols(&mut l.r_top, s_out, s_out);
+    scale_rows_cols(&mut l.t_down, s_in, s_out);
+    scale_rows_cols(&mut l.r_bot, s_in, s_in);
+    scale_rows_cols(&mut l.t_up, s_out, s_in);
+}
+
 /// The square-root (symmetric Sinkhorn) iteration of [`symmetric_scaling`]
 /// on the factors `s`, at most `iterations` steps or until every albedo is
 /// within [`SCALING_TOLERANCE`] of its target; returns the largest relative
@@ -692,7 +698,7 @@ mod tests {
     /// [`SCALING_TOLERANCE`] (asserted, so that Newton's path is what is
     /// tested; measured 5.8e-11 and 1.3e-11), and [`symmetric_scaling`]
     /// reaches every target (measured 8e-16 and 1.1e-15), checked by
-    /// summing the scaled blocks directly (not through `scaling_matrix`).
+    /// summing the scaled blocks directly (`albedos`, not `scaling_matrix`).
     /// The targets are those of known factors 2% from 1, so that a solution
     /// exists. (GGX 1.001 with `m` 0.02 is not asked: there the square-root
     /// iteration stops at 1.9e-11 and Newton's method at 3.3e-11 of these
@@ -716,21 +722,13 @@ mod tests {
         // Targets that factors 2% from 1 reach (a solution exists).
         let known: Vec<f64> = (0..no + ni).map(|k| 1.0 + 0.02 * (k as f64).sin()).collect();
         let mut bent = l.clone();
-        let (k_out, k_in) = known.split_at(no);
-        scale_rows_cols(&mut bent.r_top, k_out, k_out);
-        scale_rows_cols(&mut bent.t_down, k_in, k_out);
-        scale_rows_cols(&mut bent.r_bot, k_in, k_in);
-        scale_rows_cols(&mut bent.t_up, k_out, k_in);
+        scale_layer(&mut bent, &known, no);
         let target = albedos(&bent, &outside, &inside);
         let mut plain: Vec<f64> = target.iter().map(|&t| if t > 0.0 { 1.0 } else { 0.0 }).collect();
         let slow = square_root_scaling(&l, &outside, &inside, &target, &mut plain, MAX_SCALING_ITERATIONS).unwrap();
         let f = symmetric_scaling(&l, &outside, &inside, &target[..no], &target[no..]).unwrap();
         let mut scaled = l.clone();
-        let (f_out, f_in) = f.split_at(no);
-        scale_rows_cols(&mut scaled.r_top, f_out, f_out);
-        scale_rows_cols(&mut scaled.t_down, f_in, f_out);
-        scale_rows_cols(&mut scaled.r_bot, f_in, f_in);
-        scale_rows_cols(&mut scaled.t_up, f_out, f_in);
+        scale_layer(&mut scaled, &f, no);
         let now = albedos(&scaled, &outside, &inside);
         let worst = now
             .iter()
