@@ -71,8 +71,9 @@
 //! "Convergence"). Still missing: convergence below 0.2% with twice the
 //! nodes at the default 32 (with 64 nodes, against 128, every accuracy
 //! case is within 0.2% but devB's grazing ridge, 0.28%, at about 4 times
-//! the build time; since 2026-12-07 `--slab-nodes`, `slab_nodes` choose
-//! it outside Rust) on the thin sheets (thin tissue 0.34%, weak scatter 0.45%, its
+//! the build time; with 80 against 160 every case within 0.12%; since
+//! 2026-12-07 `--slab-nodes`, `slab_nodes` choose them outside Rust) on
+//! the thin sheets (thin tissue 0.34%, weak scatter 0.45%, its
 //! straight-through direction at 30 degrees) and at grazing angles (devB's and
 //! luster's walk ridge at grazing angles 0.99% and 0.78%); the
 //! walk's forward reflection at grazing incidence on a smooth face beyond
