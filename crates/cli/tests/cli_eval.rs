@@ -378,18 +378,12 @@ fn paper_models_and_components() {
 /// naming the flag, not ignored.
 #[test]
 fn slab_nodes_reach_the_solver() {
+    // The model and sheet of the calls below that build it.
+    const SLAB_MATTE: [&str; 5] = ["--model", "slab", "--params", "matte", "--theta-i"];
     let get = |nodes: Option<&str>| -> Vec<f64> {
-        let mut args = vec![
-            "eval",
-            "--model",
-            "slab",
-            "--params",
-            "matte",
-            "--theta-i",
-            "0,45",
-            "--theta-o",
-            "-80:80:40",
-        ];
+        let mut args = vec!["eval"];
+        args.extend(SLAB_MATTE);
+        args.extend(["0,45", "--theta-o", "-80:80:40"]);
         if let Some(n) = nodes {
             args.extend(["--slab-nodes", n]);
         }
@@ -415,22 +409,10 @@ fn slab_nodes_reach_the_solver() {
     assert!(change > 1e-5, "64 nodes gave the default's values: {change:e}");
     assert!(change < 0.01, "64 nodes moved the values by {change:e}");
     for bad in ["1", "257"] {
-        fails_with(
-            &[
-                "eval",
-                "--model",
-                "slab",
-                "--params",
-                "matte",
-                "--theta-i",
-                "0",
-                "--theta-o",
-                "0",
-                "--slab-nodes",
-                bad,
-            ],
-            &["--slab-nodes", bad, "[2, 256]"],
-        );
+        let mut args = vec!["eval"];
+        args.extend(SLAB_MATTE);
+        args.extend(["0", "--theta-o", "0", "--slab-nodes", bad]);
+        fails_with(&args, &["--slab-nodes", bad, "[2, 256]"]);
     }
     fails_with(
         &[
