@@ -13,7 +13,7 @@
 mod support;
 
 use paperbsdf_core::{Distribution, FaceScattering, PaperParams};
-use paperbsdf_slab::{SlabBsdf, SlabOptions};
+use paperbsdf_slab::SlabBsdf;
 use support::with_both_faces;
 
 /// One line per face mode, distribution and `eta` of `etas`: whether the
@@ -68,12 +68,7 @@ fn main() {
                 p.m_f
             );
             for k in [2usize, 4] {
-                let base = SlabOptions::default();
-                let opts = SlabOptions {
-                    nodes: k * base.nodes,
-                    tir_nodes: k * base.tir_nodes,
-                    ..base
-                };
+                let opts = support::options_times(k);
                 let built = SlabBsdf::with_options(p, &opts).is_ok();
                 line += &format!("  {} nodes {}", opts.nodes, if built { "built" } else { "REFUSED" });
             }

@@ -19,9 +19,12 @@
 //!
 //! `cargo run --release -p paperbsdf-slab --example smooth_forward_lobe [G_F...]`
 
+#[path = "../tests/support/mod.rs"]
+mod support;
+
 use paperbsdf_core::geometry::in_plane_directions;
 use paperbsdf_core::{Bsdf, Colour, PaperParams};
-use paperbsdf_slab::{SlabBsdf, SlabOptions};
+use support::with_nodes_times;
 
 /// An in-plane point and its values: `theta_i`, `theta_o` (transmission),
 /// the whole value on 32 and 64 nodes, the single scattering on 32 and 64.
@@ -55,19 +58,8 @@ fn main() {
             sigma_s: Colour::Scalar(sigma_t * eps),
             ..sheet.clone()
         };
-        let build = |p: &PaperParams, n: usize| {
-            SlabBsdf::with_options(
-                p,
-                &SlabOptions {
-                    nodes: n,
-                    tir_nodes: n / 2,
-                    ..SlabOptions::default()
-                },
-            )
-            .expect("build")
-        };
-        let (whole32, whole64) = (build(&sheet, 32), build(&sheet, 64));
-        let (first32, first64) = (build(&first, 32), build(&first, 64));
+        let (whole32, whole64) = (with_nodes_times(&sheet, 1), with_nodes_times(&sheet, 2));
+        let (first32, first64) = (with_nodes_times(&first, 1), with_nodes_times(&first, 2));
         let per_eps = sigma_s / sigma_t / eps;
         let mut rows: Vec<Row> = Vec::new();
         for ti in (0..=80).map(|k| 0.5 * k as f64) {

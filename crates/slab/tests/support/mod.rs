@@ -91,17 +91,20 @@ pub fn grid_albedo(f: impl Fn(DVec3) -> f64, nodes: &[f64], mu_i: f64, per: usiz
     total
 }
 
-/// The model `slab` of `p` with the default options but `k` times their
-/// nodes (outside and in the cone of total reflection).
-pub fn with_nodes_times(p: &paperbsdf_core::PaperParams, k: usize) -> paperbsdf_slab::SlabBsdf {
-    use paperbsdf_slab::{SlabBsdf, SlabOptions};
-    let base = SlabOptions::default();
-    let o = SlabOptions {
+/// The default options of the model `slab` but `k` times their nodes
+/// (outside and in the cone of total reflection).
+pub fn options_times(k: usize) -> paperbsdf_slab::SlabOptions {
+    let base = paperbsdf_slab::SlabOptions::default();
+    paperbsdf_slab::SlabOptions {
         nodes: k * base.nodes,
         tir_nodes: k * base.tir_nodes,
         ..base
-    };
-    SlabBsdf::with_options(p, &o).unwrap()
+    }
+}
+
+/// The model `slab` of `p` with [`options_times`]`(k)`.
+pub fn with_nodes_times(p: &paperbsdf_core::PaperParams, k: usize) -> paperbsdf_slab::SlabBsdf {
+    paperbsdf_slab::SlabBsdf::with_options(p, &options_times(k)).unwrap()
 }
 
 /// The model `slab` of `p` with the default options and with twice the
