@@ -62,6 +62,18 @@ impl SlabSettings {
         self.nodes.is_none()
     }
 
+    /// An error naming `flag` unless these are the default settings or
+    /// `kind` (called `name` in the message) is `slab`.
+    pub fn check_model(&self, kind: ModelKind, name: &str, flag: &str) -> Result<(), DataError> {
+        if kind != ModelKind::Slab && !self.is_default() {
+            return Err(DataError::Other {
+                file: flag.to_string(),
+                message: format!("sets the discretisation of the model `slab`; the model `{name}` has none"),
+            });
+        }
+        Ok(())
+    }
+
     /// The solver's options, or an error naming `--slab-nodes` (as `flag`
     /// spells it) and its range.
     pub fn options(&self, flag: &str) -> Result<paperbsdf_slab::SlabOptions, DataError> {
@@ -106,7 +118,7 @@ pub fn load_model_with(
         file: "--model".to_string(),
         message: e.to_string(),
     })?;
-    check_settings(kind, name, settings, flag)?;
+    settings.check_model(kind, name, flag)?;
     if kind == ModelKind::Measured {
         return Ok(LoadedModel::Measured(Box::new(crate::MeasuredBsdf::load(source)?)));
     }
@@ -129,17 +141,6 @@ pub fn load_model_with(
         });
     }
     load_model_text_with(name, &s.text, &s.origin, s.is_toml, settings, flag)
-}
-
-/// An error unless `settings` are the default or the model is `slab`.
-fn check_settings(kind: ModelKind, name: &str, settings: &SlabSettings, flag: &str) -> Result<(), DataError> {
-    if kind != ModelKind::Slab && !settings.is_default() {
-        return Err(DataError::Other {
-            file: flag.to_string(),
-            message: format!("sets the discretisation of the model `slab`; the model `{name}` has none"),
-        });
-    }
-    Ok(())
 }
 
 /// Builds model `name` from the text of a parameter set (JSON, or TOML when
@@ -174,7 +175,7 @@ pub fn load_model_text_with(
         file: origin.to_string(),
         message: e.to_string(),
     })?;
-    check_settings(kind, name, settings, flag)?;
+    settings.check_model(kind, name, flag)?;
     Ok(match kind {
         ModelKind::Paper => LoadedModel::Paper(Box::new(build(
             &loaded::<PaperParams>(text, origin, is_toml)?,

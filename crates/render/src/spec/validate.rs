@@ -272,11 +272,9 @@ fn material(name: &str, m: &MaterialSpec, file: &str, res: &Resources) -> Result
             };
             let factory: crate::material::PaperFactory = match m.model.unwrap_or_default() {
                 SheetModel::Paper => {
-                    if m.slab_nodes.is_some() {
-                        return Err(at.err(
-                            "`slab_nodes` sets the discretisation of `model = \"slab\"`; the model `paper` has none",
-                        ));
-                    }
+                    paperbsdf_io::models::SlabSettings { nodes: m.slab_nodes }
+                        .check_model(paperbsdf_core::models::ModelKind::Paper, "paper", "slab_nodes")
+                        .map_err(|e| at.err(e))?;
                     Arc::new(paper_model::paper_bsdf)
                 }
                 SheetModel::Slab => {
