@@ -7,19 +7,35 @@
 //! 0, 60 and 85 degrees), for the speed and energy numbers of the
 //! documentation.
 //!
-//! `cargo run --release -p paperbsdf-slab --example slab_build [NAME...]`
+//! `cargo run --release -p paperbsdf-slab --example slab_build [--nodes N] [NAME...]`
+//! (`--nodes N`: `N` nodes and `N / 2` in the cone of total reflection
+//! instead of the default 32 and 16, as `paperbsdf eval --slab-nodes N`).
 
 use paperbsdf_core::bsdf::albedo_from;
 use paperbsdf_core::presets::preset;
 use paperbsdf_core::{Colour, DVec3, Distribution, PaperParams};
-use paperbsdf_slab::SlabBsdf;
+use paperbsdf_slab::{SlabBsdf, SlabOptions};
 use std::time::Instant;
 
 #[path = "../../sim/examples/support/cases.rs"]
 mod cases;
 
 fn main() {
-    let only: Vec<String> = std::env::args().skip(1).collect();
+    let mut only: Vec<String> = std::env::args().skip(1).collect();
+    let mut options = SlabOptions::default();
+    if let Some(k) = only.iter().position(|a| a == "--nodes") {
+        match only.get(k + 1).and_then(|v| v.parse::<usize>().ok()) {
+            Some(n) if n >= 2 => {
+                options.nodes = n;
+                options.tir_nodes = n / 2;
+            }
+            _ => {
+                eprintln!("--nodes needs a whole number of nodes, at least 2");
+                std::process::exit(2);
+            }
+        }
+        only.drain(k..k + 2);
+    }
     let mut sheets: Vec<(String, PaperParams)> = ["matte", "luster", "glossy"]
         .iter()
         .map(|n| (n.to_string(), preset(n).expect("preset")))
@@ -44,7 +60,7 @@ fn main() {
         let mut built = None;
         for _ in 0..3 {
             let t0 = Instant::now();
-            let b = SlabBsdf::new(p).expect("build");
+            let b = SlabBsdf::with_options(p, &options).expect("build");
             best = best.min(t0.elapsed().as_secs_f64());
             built = Some(b);
         }
