@@ -14,7 +14,7 @@ use paperbsdf_io::DataError;
 /// `albedo`, `measure`).
 #[derive(clap::Args, Debug, Clone, Copy)]
 pub struct SlabArgs {
-    /// Nodes per hemisphere of the model `slab`'s discretisation (default 32; 64 converges its values to within 0.2% of twice the nodes on the accuracy cases but one, and builds about 4 times slower). Only with --model slab.
+    /// Nodes per hemisphere of the model `slab`'s discretisation (default 32, or what a slab FIT.json given as --params records; 64 converges its values to within 0.2% of twice the nodes on the accuracy cases but one, and builds about 4 times slower). Only with --model slab.
     #[arg(long = "slab-nodes")]
     pub slab_nodes: Option<usize>,
 }

@@ -12,9 +12,10 @@ use crate::cmd_fit::is_bsdf_file;
 use anyhow::{anyhow, bail, Result};
 use paperbsdf_fit::dataset::{load_dataset, Dataset};
 use paperbsdf_fit::measured::{sample_in_plane, PointFilter, Sampling};
-use paperbsdf_fit::models::build_from_params;
+use paperbsdf_fit::models::build_from_params_with;
 use paperbsdf_fit::FitOptions;
 use paperbsdf_io::angles::check_angles;
+use paperbsdf_io::models::{SlabSettings, SLAB_NODES_KEY};
 use paperbsdf_plot::figures::{make_figures, FiguresOptions, DEFAULT_FIT_THETA_I};
 use paperbsdf_plot::{draw_figure, panels_for, Figure, Layout, Row};
 use std::path::PathBuf;
@@ -256,7 +257,10 @@ pub fn run(args: PlotArgs) -> Result<()> {
                 let text = std::fs::read_to_string(f).map_err(|e| anyhow!("{f}: {e}"))?;
                 let j: serde_json::Value = serde_json::from_str(&text).map_err(|e| anyhow!("{f}: {e}"))?;
                 let name = j["model"].as_str().ok_or_else(|| anyhow!("{f}: no `model` string"))?;
-                let m = build_from_params(name, &j["params"]).map_err(|e| anyhow!("{f}: {e}"))?;
+                // A slab fit with the discretisation it was fitted with.
+                let slab =
+                    SlabSettings::recorded(j.get(SLAB_NODES_KEY), f)?.options(&format!("{f}: `{SLAB_NODES_KEY}`"))?;
+                let m = build_from_params_with(name, &j["params"], &slab).map_err(|e| anyhow!("{f}: {e}"))?;
                 let mut plotted: Vec<f64> = ds.points.iter().map(|p| p.theta_i).collect();
                 plotted.dedup();
                 (Some(m), fitted_angles(&j, &plotted))

@@ -278,6 +278,7 @@ pub fn candidates_with_faces(
 /// much as a thousand Paper BSDF builds).
 pub struct SlabFit<'a> {
     paper: &'a dyn FitModel,
+    options: paperbsdf_slab::SlabOptions,
 }
 
 /// Whether a fit of model `name` can be refined with `slab`: a fittable
@@ -297,8 +298,20 @@ impl<'a> SlabFit<'a> {
     /// `slab` over the parameters of `paper`; an error if `paper`'s
     /// parameters are not the sheet's (`lambert-glass`, [`refinable`]).
     pub fn new(paper: &'a dyn FitModel) -> Result<SlabFit<'a>, FitError> {
+        SlabFit::with_options(paper, paperbsdf_slab::SlabOptions::default())
+    }
+    /// [`SlabFit::new`] solving each sheet with `options` (its nodes: the
+    /// CLI's `--slab-nodes`).
+    pub fn with_options(
+        paper: &'a dyn FitModel,
+        options: paperbsdf_slab::SlabOptions,
+    ) -> Result<SlabFit<'a>, FitError> {
         refinable(paper.model_name())?;
-        Ok(SlabFit { paper })
+        Ok(SlabFit { paper, options })
+    }
+    /// The solver's options of every build.
+    pub fn options(&self) -> &paperbsdf_slab::SlabOptions {
+        &self.options
     }
     /// The sheet of values `x`.
     pub fn params(&self, x: &[f64]) -> Result<PaperParams, FitError> {
@@ -320,7 +333,10 @@ impl FitModel for SlabFit<'_> {
         self.paper.specs()
     }
     fn build(&self, x: &[f64]) -> Result<Box<dyn ComponentModel>, FitError> {
-        Ok(Box::new(paperbsdf_slab::SlabBsdf::new(&self.params(x)?)?))
+        Ok(Box::new(paperbsdf_slab::SlabBsdf::with_options(
+            &self.params(x)?,
+            &self.options,
+        )?))
     }
     fn params_json(&self, x: &[f64]) -> serde_json::Value {
         self.paper.params_json(x)
@@ -328,15 +344,27 @@ impl FitModel for SlabFit<'_> {
 }
 
 /// Builds model `name` from a parameter set (the `params` of a FIT.json):
-/// the fittable models and `slab` (the result of `fit --refine slab`).
+/// the fittable models and `slab` (the result of `fit --refine slab`) with
+/// the default discretisation.
 pub fn build_from_params(name: &str, params: &serde_json::Value) -> Result<Box<dyn ComponentModel>, FitError> {
+    build_from_params_with(name, params, &paperbsdf_slab::SlabOptions::default())
+}
+
+/// [`build_from_params`] solving `slab` with `slab_options` (a FIT.json's
+/// recorded `slab_nodes`, `paperbsdf_io::models::SlabSettings::recorded`);
+/// the other models ignore them.
+pub fn build_from_params_with(
+    name: &str,
+    params: &serde_json::Value,
+    slab_options: &paperbsdf_slab::SlabOptions,
+) -> Result<Box<dyn ComponentModel>, FitError> {
     let json_error = |source| FitError::ParamsJson {
         model: name.to_string(),
         source,
     };
     if name.parse::<ModelKind>() == Ok(ModelKind::Slab) {
         let p: PaperParams = serde_json::from_value(params.clone()).map_err(json_error)?;
-        return Ok(Box::new(paperbsdf_slab::SlabBsdf::new(&p)?));
+        return Ok(Box::new(paperbsdf_slab::SlabBsdf::with_options(&p, slab_options)?));
     }
     let kind = fittable(name)?;
     let typed = if kind.is_slab() {

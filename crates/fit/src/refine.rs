@@ -47,6 +47,9 @@ pub struct RefineOptions {
     /// The identifiability report's settings (`None`: no report). The
     /// report is always linearised here (`profile` is ignored).
     pub report: Option<ReportSettings>,
+    /// The discretisation of every solve (the CLI's `--slab-nodes`; the
+    /// default 32 nodes per hemisphere). FIT.json records its nodes.
+    pub slab: paperbsdf_slab::SlabOptions,
 }
 
 impl Default for RefineOptions {
@@ -64,6 +67,7 @@ impl Default for RefineOptions {
                 profile: false,
                 ..ReportSettings::default()
             }),
+            slab: paperbsdf_slab::SlabOptions::default(),
         }
     }
 }
@@ -89,6 +93,9 @@ pub struct Refinement {
     /// Whether the refinement converged (else it stopped at the iteration
     /// limit: better than the start, not a minimum).
     pub converged: bool,
+    /// The outside nodes per hemisphere every solve had
+    /// ([`RefineOptions::slab`]), FIT.json's `slab_nodes`.
+    pub slab_nodes: usize,
 }
 
 /// Refines `from`, a fit of one of `candidates` (the variants that
@@ -113,7 +120,7 @@ pub fn refine_with_slab(
             ),
         })?
         .as_ref();
-    let slab = SlabFit::new(paper)?;
+    let slab = SlabFit::with_options(paper, opts.slab)?;
     let specs = slab.specs();
     if from.x.len() != specs.len() {
         return Err(FitError::RefineFrom {
@@ -175,7 +182,7 @@ pub fn refine_with_slab(
     let start_rms = r.start_cost.sqrt();
     let mut evaluations = r.evaluations + 1; // and the final model's solve
     let x = slab.values(&r.u);
-    let model = SlabBsdf::new(&slab.params(&x)?)?;
+    let model = SlabBsdf::with_options(&slab.params(&x)?, &opts.slab)?;
     let (rms, _) = rms_log_error(&model, &fitted, channels).expect("points");
     let ident = opts.report.as_ref().and_then(|rs| {
         let rs = ReportSettings { profile: false, ..*rs };
@@ -214,6 +221,7 @@ pub fn refine_with_slab(
         from_extrapolation_rms_log_error: from.extrapolation_rms_log_error,
         start_rms_log_error: start_rms,
         converged,
+        slab_nodes: opts.slab.nodes,
     })
 }
 
@@ -225,6 +233,8 @@ impl Refinement {
     pub fn to_json(&self, data: &[String], fit_theta_i: Option<&[f64]>) -> serde_json::Value {
         let mut j = self.outcome.to_json(data, fit_theta_i);
         j["refined_from"] = self.from_model.clone().into();
+        // What `eval`, `plot` and Python solve the fit with (io's SLAB_NODES_KEY).
+        j[paperbsdf_io::models::SLAB_NODES_KEY] = self.slab_nodes.into();
         j["refinement"] = serde_json::json!({
             "from_model": self.from_model,
             "from_params": self.from_params,

@@ -56,7 +56,33 @@ pub struct SlabSettings {
 /// "Convergence").
 pub const SLAB_NODES_RANGE: std::ops::RangeInclusive<usize> = 2..=256;
 
+/// The key of a FIT.json that records the discretisation a `slab` fit was
+/// solved with (`paperbsdf fit --refine slab [--slab-nodes N]`): its
+/// outside nodes per hemisphere, as [`SlabSettings::nodes`].
+pub const SLAB_NODES_KEY: &str = "slab_nodes";
+
 impl SlabSettings {
+    /// The settings a FIT.json records (`value`: its [`SLAB_NODES_KEY`],
+    /// `None` if absent, the default then), or an error naming `origin`,
+    /// the key and the allowed range when it is not a whole number in
+    /// [`SLAB_NODES_RANGE`].
+    pub fn recorded(value: Option<&serde_json::Value>, origin: &str) -> Result<SlabSettings, DataError> {
+        let Some(v) = value else {
+            return Ok(SlabSettings::default());
+        };
+        match v.as_u64().and_then(|n| usize::try_from(n).ok()) {
+            Some(n) if SLAB_NODES_RANGE.contains(&n) => Ok(SlabSettings { nodes: Some(n) }),
+            _ => Err(DataError::Other {
+                file: origin.to_string(),
+                message: format!(
+                    "`{SLAB_NODES_KEY}`: {v} is not a whole number of nodes per hemisphere in the allowed range [{}, {}]",
+                    SLAB_NODES_RANGE.start(),
+                    SLAB_NODES_RANGE.end()
+                ),
+            }),
+        }
+    }
+
     /// Whether these are the default settings.
     pub fn is_default(&self) -> bool {
         self.nodes.is_none()
@@ -139,6 +165,13 @@ pub fn load_model_with(
                 "presets are Paper BSDF parameters (models paper, reduced-multilayer), not `{name}` parameters"
             ),
         });
+    }
+    // A `slab` fit is evaluated with the discretisation it was fitted with,
+    // unless `settings` choose another.
+    let recorded = SlabSettings::recorded(s.fit_slab_nodes.as_ref(), &s.origin)?;
+    if settings.is_default() && !recorded.is_default() {
+        let flag = format!("{}: `{SLAB_NODES_KEY}`", s.origin);
+        return load_model_text_with(name, &s.text, &s.origin, s.is_toml, &recorded, &flag);
     }
     load_model_text_with(name, &s.text, &s.origin, s.is_toml, settings, flag)
 }

@@ -68,6 +68,10 @@ pub struct Source {
     pub is_toml: bool,
     /// The model of a FIT.json (`paper`, `lambert-glass`, ...), if the source is one.
     pub fit_model: Option<String>,
+    /// The value of a FIT.json's `slab_nodes` (the discretisation a `slab`
+    /// fit was solved with, `paperbsdf fit --refine slab`), unchecked: see
+    /// [`crate::models::SlabSettings::recorded`].
+    pub fit_slab_nodes: Option<serde_json::Value>,
     /// The preset name, if the source is one.
     pub preset: Option<String>,
 }
@@ -78,12 +82,17 @@ struct FitFile<'a> {
     model: String,
     #[serde(borrow)]
     params: &'a serde_json::value::RawValue,
+    /// Kept as any JSON value so that a bad one is reported as such, not
+    /// taken for "not a FIT.json".
+    #[serde(default)]
+    slab_nodes: Option<serde_json::Value>,
 }
 
-/// If `text` is a FIT.json, its model and `text` with everything outside the
-/// `params` object replaced by spaces (newlines kept): still valid JSON, the
-/// parameters, with line and column numbers those of the fit file.
-fn fit_params(text: &str) -> Option<(String, String)> {
+/// If `text` is a FIT.json, its model, `text` with everything outside the
+/// `params` object replaced by spaces (newlines kept: still valid JSON, the
+/// parameters, with line and column numbers those of the fit file) and its
+/// `slab_nodes` value, if any.
+fn fit_params(text: &str) -> Option<(String, String, Option<serde_json::Value>)> {
     let fit: FitFile = serde_json::from_str(text).ok()?;
     let raw = fit.params.get();
     let start = (raw.as_ptr() as usize).checked_sub(text.as_ptr() as usize)?;
@@ -92,7 +101,11 @@ fn fit_params(text: &str) -> Option<(String, String)> {
         return None;
     }
     let blank = |s: &str| -> String { s.chars().map(|c| if c == '\n' { '\n' } else { ' ' }).collect() };
-    Some((fit.model, blank(&text[..start]) + raw + &blank(&text[end..])))
+    Some((
+        fit.model,
+        blank(&text[..start]) + raw + &blank(&text[end..]),
+        fit.slab_nodes,
+    ))
 }
 
 /// Reads `source` (a path, inline JSON starting with `{`, a preset name or a
@@ -105,6 +118,7 @@ pub fn read_source_full(source: &str) -> Result<Source, DataError> {
             origin: "<inline>".to_string(),
             is_toml: false,
             fit_model: None,
+            fit_slab_nodes: None,
             preset: None,
         });
     }
@@ -116,6 +130,7 @@ pub fn read_source_full(source: &str) -> Result<Source, DataError> {
                 origin: format!("preset `{source}`"),
                 is_toml: false,
                 fit_model: None,
+                fit_slab_nodes: None,
                 preset: Some(source.to_string()),
             });
         }
@@ -132,12 +147,13 @@ pub fn read_source_full(source: &str) -> Result<Source, DataError> {
     })?;
     let is_toml = source.to_ascii_lowercase().ends_with(".toml");
     if !is_toml {
-        if let Some((model, params)) = fit_params(&text) {
+        if let Some((model, params, slab_nodes)) = fit_params(&text) {
             return Ok(Source {
                 text: params,
                 origin: source.to_string(),
                 is_toml,
                 fit_model: Some(model),
+                fit_slab_nodes: slab_nodes,
                 preset: None,
             });
         }
@@ -147,6 +163,7 @@ pub fn read_source_full(source: &str) -> Result<Source, DataError> {
         origin: source.to_string(),
         is_toml,
         fit_model: None,
+        fit_slab_nodes: None,
         preset: None,
     })
 }

@@ -560,10 +560,12 @@ fn simulate<'py>(
 /// returns the JSON text of the fit (the CLI's `--out` file). `fix` holds
 /// parameters (`--fix NAME=VALUE`), `face_scattering` is `multiple` or
 /// `single`, `refine` = `slab` refines the fit with the model `slab`
-/// (`--refine slab`, at most `refine_max_iter` iterations).
+/// (`--refine slab`, at most `refine_max_iter` iterations, each solve with
+/// `slab_nodes` nodes per hemisphere: `--slab-nodes`).
 #[pyfunction]
 #[pyo3(signature = (data, model, thickness, fit_theta_i, dists, samples, starts, max_iter, seed,
-                    fix = Vec::new(), face_scattering = "multiple", refine = None, refine_max_iter = 40))]
+                    fix = Vec::new(), face_scattering = "multiple", refine = None, refine_max_iter = 40,
+                    slab_nodes = None))]
 #[allow(clippy::too_many_arguments)]
 fn fit(
     py: Python<'_>,
@@ -580,6 +582,7 @@ fn fit(
     face_scattering: &str,
     refine: Option<String>,
     refine_max_iter: usize,
+    slab_nodes: Option<usize>,
 ) -> PyResult<String> {
     if samples == 0 || starts == 0 || max_iter == 0 || refine_max_iter == 0 {
         return Err(value_error(
@@ -599,7 +602,14 @@ fn fit(
     }
     if refine.is_some() {
         paperbsdf_fit::models::refinable(model).map_err(|e| value_error(e.to_string()))?;
+    } else if slab_nodes.is_some() {
+        return Err(value_error(
+            "slab_nodes: sets the discretisation of the refinement with slab; give it with refine=\"slab\"",
+        ));
     }
+    let slab_options = SlabSettings { nodes: slab_nodes }
+        .options("slab_nodes")
+        .map_err(|e| value_error(e.to_string()))?;
     for (name, v) in &fix {
         if !v.is_finite() {
             return Err(value_error(format!("fix: {name} = {v}: the value must be finite")));
@@ -642,6 +652,7 @@ fn fit(
                     ..Default::default()
                 },
                 fit_theta_i: fit_theta_i.clone(),
+                slab: slab_options,
                 ..Default::default()
             };
             paperbsdf_fit::refine_with_slab(&ds.points, ds.channels, &cands, &out, &ropts)
@@ -662,6 +673,17 @@ fn read_source(source: &str) -> PyResult<(String, String, bool)> {
     paperbsdf_io::params::read_source(source).map_err(|e| value_error(e.to_string()))
 }
 
+/// The nodes per hemisphere a `slab` FIT.json was solved with (its
+/// `slab_nodes`; `None` if absent or if `source` is not a FIT.json), or a
+/// `ValueError` naming the file when the value is not allowed.
+#[pyfunction]
+fn recorded_slab_nodes(source: &str) -> PyResult<Option<usize>> {
+    let s = paperbsdf_io::read_source_full(source).map_err(|e| value_error(e.to_string()))?;
+    SlabSettings::recorded(s.fit_slab_nodes.as_ref(), &s.origin)
+        .map(|r| r.nodes)
+        .map_err(|e| value_error(e.to_string()))
+}
+
 /// Whether a flags value (bits of `BsdfFlags`) has a delta lobe.
 #[pyfunction]
 fn flags_is_specular(flags: u8) -> bool {
@@ -679,6 +701,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(params_json, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
+    m.add_function(wrap_pyfunction!(recorded_slab_nodes, m)?)?;
     m.add_function(wrap_pyfunction!(flags_is_specular, m)?)?;
     m.add_function(wrap_pyfunction!(read_source, m)?)?;
     Ok(())

@@ -108,6 +108,32 @@ def test_slab_nodes_match_cli(cli, tmp_path):
         paperbsdf.Bsdf("paper", "matte", slab_nodes=64)
 
 
+def test_slab_fit_file_is_solved_with_its_recorded_nodes(tmp_path, repo):
+    # A slab FIT.json (`fit(..., refine="slab", slab_nodes=N)` writes
+    # `slab_nodes`) is solved with the nodes it records, as `paperbsdf eval
+    # --params FIT.json` does; an explicit `slab_nodes` wins; a bad recorded
+    # value is a ValueError naming the file and the key; `slab_nodes` without
+    # the refinement is refused before any fit.
+    wi, wo = hard_pairs()
+    params = paperbsdf.preset("luster")
+    fit_file = tmp_path / "FIT.json"
+    fit_file.write_text(json.dumps({"model": "slab", "params": params, "slab_nodes": 16}))
+    recorded = paperbsdf.Bsdf("slab", str(fit_file)).eval(wi, wo)
+    np.testing.assert_array_equal(recorded, paperbsdf.Bsdf("slab", params, slab_nodes=16).eval(wi, wo))
+    base = paperbsdf.Bsdf("slab", params).eval(wi, wo)
+    assert np.abs(recorded - base).max() > 1e-6 * np.abs(base).max()
+    np.testing.assert_array_equal(paperbsdf.Bsdf("slab", fit_file, slab_nodes=32).eval(wi, wo), base)
+    for bad in (1, 1000, "many", 16.5):
+        fit_file.write_text(json.dumps({"model": "slab", "params": params, "slab_nodes": bad}))
+        with pytest.raises(ValueError) as e:
+            paperbsdf.Bsdf("slab", str(fit_file))
+        assert all(p in str(e.value) for p in ("FIT.json", "slab_nodes", "[2, 256]")), str(e.value)
+    with pytest.raises(ValueError, match="slab_nodes.*refine"):
+        paperbsdf.fit(os.path.join(repo, "data", "matte.csv"), slab_nodes=16)
+    with pytest.raises(ValueError, match="slab_nodes.*range"):
+        paperbsdf.fit(os.path.join(repo, "data", "matte.csv"), refine="slab", slab_nodes=1)
+
+
 def test_components_sum_to_all():
     b = paperbsdf.PaperBsdf(UNEQUAL)
     wi, wo = hard_pairs()

@@ -105,11 +105,10 @@ fn paper_model_key() {
 fn slab_nodes_key() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("scene.toml");
-    let value = |extra: &str| -> f64 {
-        let text = GOOD.replace(
-            "preset = \"matte\"",
-            &format!("preset = \"matte\"\nmodel = \"slab\"{extra}"),
-        );
+    // The sheet's value lit at 45 degrees, seen at -80, with the material's
+    // `preset = "matte"` replaced by `material`.
+    let value_with = |material: &str| -> f64 {
+        let text = GOOD.replace("preset = \"matte\"", material);
         std::fs::write(&p, &text).unwrap();
         let scene = load_scene(&p).unwrap();
         let sheet = scene
@@ -125,9 +124,38 @@ fn slab_nodes_key() {
             .expect("the paper material");
         sheet.mean()
     };
+    let value = |extra: &str| value_with(&format!("preset = \"matte\"\nmodel = \"slab\"{extra}"));
     let (base, coarse) = (value(""), value("\nslab_nodes = 16"));
     let change = (coarse / base - 1.0).abs();
     assert!(change > 1e-5 && change < 0.02, "16 nodes moved the value by {change:e}");
+    // A `slab` fit (`paperbsdf fit --refine slab --slab-nodes 16` writes
+    // `slab_nodes`) as `params`: solved with the nodes it records, unless the
+    // material sets `slab_nodes`; with `model = "paper"` an error.
+    let fit = |nodes: serde_json::Value| {
+        let params = serde_json::to_value(paperbsdf_core::presets::preset("matte").unwrap()).unwrap();
+        let j = serde_json::json!({"model": "slab", "params": params, "slab_nodes": nodes});
+        std::fs::write(dir.path().join("fit.json"), serde_json::to_string_pretty(&j).unwrap()).unwrap();
+    };
+    fit(16.into());
+    let with_params = |extra: &str| value_with(&format!("params = \"fit.json\"\nmodel = \"slab\"{extra}"));
+    assert_eq!(with_params(""), coarse, "the fit's 16 nodes");
+    assert_eq!(with_params("\nslab_nodes = 32"), base, "the material's slab_nodes wins");
+    let m = load_err(dir.path(), &GOOD.replace("preset = \"matte\"", "params = \"fit.json\""));
+    contains_all(
+        &m,
+        &[
+            "materials.sheet",
+            "fit.json",
+            "fit of the model `slab`",
+            "model = \"slab\"",
+        ],
+    );
+    fit(1000.into());
+    let m = load_err(
+        dir.path(),
+        &GOOD.replace("preset = \"matte\"", "params = \"fit.json\"\nmodel = \"slab\""),
+    );
+    contains_all(&m, &["materials.sheet", "fit.json", "`slab_nodes`", "1000", "[2, 256]"]);
     let m = load_err(
         dir.path(),
         &GOOD.replace(

@@ -104,6 +104,19 @@ def _dirs(x: Any, name: str) -> np.ndarray:
     return np.ascontiguousarray(a)
 
 
+def _slab_nodes_arg(slab_nodes: Any) -> Optional[int]:
+    """``slab_nodes`` checked to be ``None`` or a whole number (the range is
+    checked natively, with the CLI's message; a negative number, which the
+    native side cannot take, gets it here)."""
+    if slab_nodes is None:
+        return None
+    if isinstance(slab_nodes, bool) or not isinstance(slab_nodes, int):
+        raise ValueError(f"slab_nodes: expected a whole number of nodes, got {slab_nodes!r}")
+    if slab_nodes < 0:
+        raise ValueError(f"slab_nodes: {slab_nodes} is outside the allowed range [2, 256] of nodes per hemisphere")
+    return slab_nodes
+
+
 class Bsdf:
     """A scattering model by name: ``Bsdf(model, params, slab_nodes=None)``.
 
@@ -114,15 +127,19 @@ class Bsdf:
     of its discretisation (2 to 256; ``None`` for the default 32; 64
     converges its values to within 0.2% of twice the nodes on the accuracy
     cases but one and builds about 4 times slower; the CLI's ``--slab-nodes``).
+    A ``slab`` FIT.json (``fit(..., refine="slab")``) is solved with the nodes
+    it records (``slab_nodes``) unless ``slab_nodes`` is given, as in the CLI.
     """
 
     def __init__(self, model: str, params: Any, slab_nodes: Optional[int] = None):
         if not isinstance(model, str):
             raise ValueError(f"model: expected a name ({', '.join(MODEL_NAMES)}), got {type(model).__name__}")
-        if slab_nodes is not None and (isinstance(slab_nodes, bool) or not isinstance(slab_nodes, int)):
-            raise ValueError(f"slab_nodes: expected a whole number of nodes, got {slab_nodes!r}")
-        if slab_nodes is not None and slab_nodes < 0:
-            raise ValueError(f"slab_nodes: {slab_nodes} is outside the allowed range [2, 256] of nodes per hemisphere")
+        slab_nodes = _slab_nodes_arg(slab_nodes)
+        if slab_nodes is None and model == "slab" and isinstance(params, (str, os.PathLike)):
+            # A slab FIT.json is solved with the nodes it was fitted with.
+            path = os.fspath(params)
+            if os.path.isfile(path):
+                slab_nodes = _native.recorded_slab_nodes(path)
         text, origin, is_toml = _params_text(params, model)
         self._native = _native.Model(model, text, origin, is_toml, slab_nodes)
         self._text = text
@@ -271,6 +288,7 @@ def fit(
     face_scattering: str = "multiple",
     refine: str | None = None,
     refine_max_iter: int = 40,
+    slab_nodes: int | None = None,
 ) -> dict:
     """Fits ``model`` (``paper``, ``lambert-glass``, ``reduced-multilayer``) to
     measurement files (``paperbsdf fit``): CSV with ``kind,theta_i_deg,theta_o_deg``
@@ -280,7 +298,9 @@ def fit(
     ``face_scattering`` is ``"multiple"`` or ``"single"`` (Walter's faces).
     ``refine="slab"`` refines the fit with the model ``slab`` from its optimum
     (the CLI's ``--refine slab``: a solve per evaluation, minutes; the result's
-    ``model`` is ``slab``, the first fit is under ``refinement``).
+    ``model`` is ``slab``, the first fit is under ``refinement``), each solve with
+    ``slab_nodes`` nodes per hemisphere (the CLI's ``--slab-nodes``; ``None``: 32),
+    which the result records as ``slab_nodes``.
     Returns the CLI's fit JSON as a dict (``model``, ``params``, ``rms_log_error``,
     ``extrapolation_rms_log_error``, ``errors``, ...)."""
     if isinstance(data, (str, os.PathLike)):
@@ -292,5 +312,6 @@ def fit(
         [str(d) for d in dists], int(samples), int(starts), int(max_iter), int(seed),
         [(str(k), float(v)) for k, v in (fix or {}).items()], str(face_scattering),
         None if refine is None else str(refine), int(refine_max_iter),
+        _slab_nodes_arg(slab_nodes),
     )
     return json.loads(text)

@@ -15,7 +15,8 @@ Properties (scene XML ``<string name=... value=.../>`` or ``load_dict`` keys):
   ``rough-dielectric``;
 - ``mode``: ``auto`` (default), ``native`` or ``exact`` (below);
 - ``slab_nodes`` (integer, model ``slab`` only): the nodes per hemisphere
-  of its discretisation, 2 to 256 (default 32; 64 converges its values to
+  of its discretisation, 2 to 256 (default 32, or what a ``slab`` FIT.json
+  given as ``params`` records; 64 converges its values to
   within 0.2% of twice the nodes on the accuracy cases but one, and builds
   about 4 times slower).
 

@@ -128,8 +128,16 @@ fn grey_image(rel: &str, scale: Option<f64>, key: &str, at: At, res: &Resources)
 }
 
 /// Reads a paper parameter file (embedded for built-in scenes, else relative to
-/// the scene file); errors are the material's, saying `params`.
-fn params_file(rel: &str, at: At, res: &Resources) -> Result<PaperParams, SceneError> {
+/// the scene file) for a material of `model`; errors are the material's,
+/// saying `params`. With it the discretisation a FIT.json records
+/// (`slab_nodes` of a `slab` fit; default otherwise).
+fn params_file(
+    rel: &str,
+    model: SheetModel,
+    at: At,
+    res: &Resources,
+) -> Result<(PaperParams, paperbsdf_io::models::SlabSettings), SceneError> {
+    let mut recorded = paperbsdf_io::models::SlabSettings::default();
     let fail = |e: &dyn std::fmt::Display| at.err(format!("`params`: {e}"));
     let loaded = if let Some(b) = res.embedded.get(rel) {
         let text = std::str::from_utf8(b).map_err(|e| fail(&format!("parameter file '{rel}': {e}")))?;
@@ -150,11 +158,27 @@ fn params_file(rel: &str, at: At, res: &Resources) -> Result<PaperParams, SceneE
             rel.to_string()
         };
         let s = paperbsdf_io::read_source_full(&source).map_err(|e| fail(&e))?;
-        if let Some(model) = s.fit_model.as_deref().filter(|m| *m != ModelKind::Paper.name()) {
-            return Err(fail(&format!(
-                "{}: a fit of the model `{model}`; a `paper` material needs a fit of the `paper` model",
-                s.origin
-            )));
+        // A fit of `paper` for either model; a fit of `slab` (`fit --refine
+        // slab`) for `model = "slab"`, solved with the nodes it records.
+        match s.fit_model.as_deref() {
+            None => {}
+            Some(f) if f == ModelKind::Paper.name() => {}
+            Some(f) if f == ModelKind::Slab.name() && model == SheetModel::Slab => {
+                recorded = paperbsdf_io::models::SlabSettings::recorded(s.fit_slab_nodes.as_ref(), &s.origin)
+                    .map_err(|e| fail(&e))?;
+            }
+            Some(f) if f == ModelKind::Slab.name() => {
+                return Err(fail(&format!(
+                    "{}: a fit of the model `slab`; render it with `model = \"slab\"` (a `paper` material needs a fit of the `paper` model)",
+                    s.origin
+                )));
+            }
+            Some(f) => {
+                return Err(fail(&format!(
+                    "{}: a fit of the model `{f}`; a paper material needs a fit of the `paper` or `slab` model",
+                    s.origin
+                )));
+            }
         }
         paperbsdf_io::Loaded {
             value: paperbsdf_io::params::parse_text::<PaperParams>(&s.text, &s.origin, s.is_toml)
@@ -165,16 +189,29 @@ fn params_file(rel: &str, at: At, res: &Resources) -> Result<PaperParams, SceneE
         }
     };
     loaded.value.validate().map_err(|e| fail(&loaded.param_error(e)))?;
-    Ok(loaded.value)
+    Ok((loaded.value, recorded))
 }
 
 /// The parameters of a paper material: its keys over a preset or parameter
 /// file, or (without either) a full set, the distributions defaulting to GGX
-/// and the face scattering to its default; validated.
-fn paper_params(m: &PaperSpec, at: At, res: &Resources) -> Result<PaperParams, SceneError> {
+/// and the face scattering to its default; validated. With it the
+/// discretisation of `slab`: the material's `slab_nodes`, else what its
+/// `params` FIT.json records.
+fn paper_params(
+    m: &PaperSpec,
+    at: At,
+    res: &Resources,
+) -> Result<(PaperParams, paperbsdf_io::models::SlabSettings), SceneError> {
+    let mut slab = paperbsdf_io::models::SlabSettings { nodes: m.slab_nodes };
     let base = match (&m.preset, &m.params) {
         (Some(_), Some(_)) => return Err(at.err("give `preset` or `params`, not both")),
-        (None, Some(rel)) => Some(params_file(rel, at, res)?),
+        (None, Some(rel)) => {
+            let (p, recorded) = params_file(rel, m.model.unwrap_or_default(), at, res)?;
+            if slab.is_default() {
+                slab = recorded;
+            }
+            Some(p)
+        }
         (Some(name), None) => Some(paper_model::preset(name).ok_or_else(|| {
             let names = paper_model::preset_names();
             at.err(format!(
@@ -211,7 +248,7 @@ fn paper_params(m: &PaperSpec, at: At, res: &Resources) -> Result<PaperParams, S
     }
     let p = PaperParams::deserialize(t).map_err(|e| at.err(e.message()))?;
     p.validate().map_err(|e| at.err(e))?;
-    Ok(p)
+    Ok((p, slab))
 }
 
 /// `v` as a TOML table (a struct's `None` fields left out).
@@ -244,7 +281,7 @@ fn material(name: &str, m: &MaterialSpec, file: &str, res: &Resources) -> Result
             Material::Fixed(Arc::new(b))
         }
         MaterialSpec::Paper(m) => {
-            let p = paper_params(m, at, res)?;
+            let (p, slab) = paper_params(m, at, res)?;
             let thickness = match &m.thickness_map {
                 None => None,
                 Some(t) => {
@@ -272,15 +309,12 @@ fn material(name: &str, m: &MaterialSpec, file: &str, res: &Resources) -> Result
             };
             let factory: crate::material::PaperFactory = match m.model.unwrap_or_default() {
                 SheetModel::Paper => {
-                    paperbsdf_io::models::SlabSettings { nodes: m.slab_nodes }
-                        .check_model(paperbsdf_core::models::ModelKind::Paper, "paper", "slab_nodes")
+                    slab.check_model(paperbsdf_core::models::ModelKind::Paper, "paper", "slab_nodes")
                         .map_err(|e| at.err(e))?;
                     Arc::new(paper_model::paper_bsdf)
                 }
                 SheetModel::Slab => {
-                    let options = paperbsdf_io::models::SlabSettings { nodes: m.slab_nodes }
-                        .options("slab_nodes")
-                        .map_err(|e| at.err(e))?;
+                    let options = slab.options("slab_nodes").map_err(|e| at.err(e))?;
                     Arc::new(move |p: &PaperParams| paper_model::slab_bsdf_with(p, &options))
                 }
             };
