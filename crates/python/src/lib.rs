@@ -673,6 +673,14 @@ fn read_source(source: &str) -> PyResult<(String, String, bool)> {
     paperbsdf_io::params::read_source(source).map_err(|e| value_error(e.to_string()))
 }
 
+/// The allowed nodes per hemisphere of the model `slab`, `(lowest,
+/// highest)` (`paperbsdf_io::models::SLAB_NODES_RANGE`).
+#[pyfunction]
+fn slab_nodes_range() -> (usize, usize) {
+    let r = paperbsdf_io::models::SLAB_NODES_RANGE;
+    (*r.start(), *r.end())
+}
+
 /// The nodes per hemisphere a `slab` FIT.json was solved with (its
 /// `slab_nodes`; `None` if absent or if `source` is not a FIT.json), or a
 /// `ValueError` naming the file when the value is not allowed.
@@ -702,6 +710,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(recorded_slab_nodes, m)?)?;
+    m.add_function(wrap_pyfunction!(slab_nodes_range, m)?)?;
     m.add_function(wrap_pyfunction!(flags_is_specular, m)?)?;
     m.add_function(wrap_pyfunction!(read_source, m)?)?;
     Ok(())

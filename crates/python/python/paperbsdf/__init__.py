@@ -113,7 +113,8 @@ def _slab_nodes_arg(slab_nodes: Any) -> Optional[int]:
     if isinstance(slab_nodes, bool) or not isinstance(slab_nodes, int):
         raise ValueError(f"slab_nodes: expected a whole number of nodes, got {slab_nodes!r}")
     if slab_nodes < 0:
-        raise ValueError(f"slab_nodes: {slab_nodes} is outside the allowed range [2, 256] of nodes per hemisphere")
+        lo, hi = _native.slab_nodes_range()
+        raise ValueError(f"slab_nodes: {slab_nodes} is outside the allowed range [{lo}, {hi}] of nodes per hemisphere")
     return slab_nodes
 
 
