@@ -25,6 +25,8 @@
 //! 32 and 16, against twice as many, for how the change falls with the
 //! nodes; `--g-f G`: the forward lobe's asymmetry `g_f` of every case set
 //! to `G`; `--m M`: both faces' roughness set to `M`, 0 for smooth faces;
+//! `--eta-f E` and `--eta-b E`: the front's and the base's index set to
+//! `E` (a coated front where they differ, docs/design.md 4.1);
 //! the base build's time is printed).
 
 use paperbsdf_core::bsdf::albedo_from;
@@ -115,6 +117,8 @@ fn main() {
     };
     let g_f = value_of("--g-f", -0.98..=0.98);
     let m = value_of("--m", 0.0..=1.5);
+    let eta_f = value_of("--eta-f", 1.0..=5.0);
+    let eta_b = value_of("--eta-b", 1.0..=5.0);
     let cases: Vec<_> = cases::cases()
         .into_iter()
         .filter(|(n, _)| only.is_empty() || only.contains(n))
@@ -123,6 +127,8 @@ fn main() {
                 g_f: g_f.unwrap_or(p.g_f),
                 m_f: m.unwrap_or(p.m_f),
                 m_b: m.unwrap_or(p.m_b),
+                eta_f: eta_f.unwrap_or(p.eta_f),
+                eta_b: eta_b.unwrap_or(p.eta_b),
                 ..p
             };
             (n, p)

@@ -34,10 +34,10 @@
 //! light, from either side; the BSDF between nodes. **The model `slab`**
 //! ([`bsdf::SlabBsdf`], in core's registry as `ModelKind::Slab`, built by
 //! `paperbsdf_io`): the lit face's reflection analytic (core's face), a
-//! rough coated front's single round trip through its coating and an
-//! uncoated sheet's unscattered transmission through two rough faces
-//! analytic ([`two_crossings`]: tables of the exact integrals, since
-//! 2026-12-06), the
+//! rough coated front's single round trip through its coating and a
+//! sheet's unscattered transmission through two rough faces (and a coated
+//! front's boundary, since 2026-12-07) analytic ([`two_crossings`]: tables
+//! of the exact integrals, since 2026-12-06), the
 //! delta lobes of smooth sheets in closed form, the rest interpolated from
 //! the Fourier tables; `eval`, `sample`, `pdf` (chi-square tested),
 //! components.

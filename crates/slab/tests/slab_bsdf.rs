@@ -120,6 +120,19 @@ fn cases() -> Vec<(&'static str, PaperParams)> {
             FaceScattering::Single,
         ),
     ));
+    // A thin coated sheet (optical thickness 0.6): its unscattered
+    // transmission crosses the coating/base boundary (a base less dense
+    // than the coating: total reflection there), analytic since 2026-12-07.
+    v.push((
+        "thin-coated",
+        sheet(
+            0.02,
+            0.5,
+            30.0,
+            [(1.5, 0.3, Ggx), (1.4, 0.1, Beckmann)],
+            FaceScattering::Multiple,
+        ),
+    ));
     v.push((
         "coated-rough",
         sheet(
@@ -387,6 +400,16 @@ fn energy_closes_without_absorption() {
             FaceScattering::Multiple,
         ),
         thin_between_smooth_faces(),
+        // Thin and coated (optical thickness 0.6, a base less dense than
+        // the coating): the unscattered term through the boundary (since
+        // 2026-12-07).
+        sheet(
+            0.02,
+            0.0,
+            30.0,
+            [(1.5, 0.15, Distribution::Ggx), (1.4, 0.3, Distribution::Beckmann)],
+            FaceScattering::Multiple,
+        ),
     ];
     let (mut worst_table, mut worst_total, mut worst_lobe) = (0.0f64, 0.0f64, 0.0f64);
     for (k, p) in sheets.iter().enumerate() {
