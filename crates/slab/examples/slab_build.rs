@@ -2,7 +2,7 @@
 //! that are not presets, and the worst case for the build (an RGB thin sheet
 //! with unequal faces: each colour channel has its own optical thickness and
 //! so its own analytic unscattered term, and its GGX 0.1 front's walk takes
-//! 384 orders), and prints the build time (the fastest of three), the
+//! 384 orders) and a thin coated sheet (`thin-coated`), and prints the build time (the fastest of three), the
 //! memory per sheet and the directional albedos (R + T from both sides at
 //! 0, 60 and 85 degrees), for the speed and energy numbers of the
 //! documentation.
@@ -52,6 +52,27 @@ fn main() {
             m_b: 0.25,
             dist_f: Distribution::Ggx,
             dist_b: Distribution::Beckmann,
+            ..preset("matte").expect("preset")
+        },
+    ));
+    // A thin coated sheet (tests/cli_refine.rs's): its unscattered term
+    // crosses the coating/base boundary (since 2026-12-07).
+    sheets.push((
+        "thin-coated".into(),
+        PaperParams {
+            name: Some("thin coated sheet, GGX 0.3 front of 1.5 over a base of 1.4, GGX 0.15 back".into()),
+            d: 0.03,
+            sigma_a: Colour::Scalar(0.5),
+            sigma_s: Colour::Scalar(60.0),
+            g_f: 0.6,
+            g_b: -0.3,
+            w_b: 0.2,
+            eta_f: 1.5,
+            eta_b: 1.4,
+            m_f: 0.3,
+            m_b: 0.15,
+            dist_f: Distribution::Ggx,
+            dist_b: Distribution::Ggx,
             ..preset("matte").expect("preset")
         },
     ));
