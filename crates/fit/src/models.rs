@@ -309,10 +309,6 @@ impl<'a> SlabFit<'a> {
         refinable(paper.model_name())?;
         Ok(SlabFit { paper, options })
     }
-    /// The solver's options of every build.
-    pub fn options(&self) -> &paperbsdf_slab::SlabOptions {
-        &self.options
-    }
     /// The sheet of values `x`.
     pub fn params(&self, x: &[f64]) -> Result<PaperParams, FitError> {
         serde_json::from_value(self.paper.params_json(x)).map_err(|source| FitError::ParamsJson {

@@ -2721,31 +2721,25 @@ impl SlabBsdf {
             let proj = match term {
                 Some(_) => {
                     let [f, b] = &prepared.faces;
-                    // The lit face's first crossing into the medium's grid:
-                    // through a coated front's boundary (diagonal: the
-                    // coating's grid to the base's) when the front is lit.
-                    let into =
-                        |m: usize, lit: &crate::interface::ProjectedFace, front_lit: bool| match &prepared.coating {
-                            Some(c) if front_lit => &c.boundary.t_down * lit.first_t(m).0,
-                            _ => lit.first_t(m).0.clone(),
-                        };
-                    // The exit face's first crossing out of the medium's grid
-                    // (through the boundary when it is the coated front).
-                    let out_of =
-                        |m: usize, exit: &crate::interface::ProjectedFace, front_exit: bool| match &prepared.coating {
-                            Some(c) if front_exit => exit.first_t(m).1 * &c.boundary.t_up,
-                            _ => exit.first_t(m).1.clone(),
-                        };
+                    // Through a coated front, the light also crosses its
+                    // boundary (diagonal between the coating's grid and the
+                    // base's): after the lit front, before the exit front.
                     let through = |m: usize,
                                    lit: &crate::interface::ProjectedFace,
                                    exit: &crate::interface::ProjectedFace,
                                    front_lit: bool| {
                         let d = unsc.medium[m].t_down.diagonal();
-                        let mut inner = into(m, lit, front_lit);
+                        let mut inner = match &prepared.coating {
+                            Some(c) if front_lit => &c.boundary.t_down * lit.first_t(m).0,
+                            _ => lit.first_t(m).0.clone(),
+                        };
                         for (mut row, di) in inner.row_iter_mut().zip(d.iter()) {
                             row *= *di;
                         }
-                        out_of(m, exit, !front_lit) * inner
+                        match &prepared.coating {
+                            Some(c) if !front_lit => exit.first_t(m).1 * (&c.boundary.t_up * inner),
+                            _ => exit.first_t(m).1 * inner,
+                        }
                     };
                     [
                         (0..m_solved).map(|m| through(m, f, b, true)).collect(),

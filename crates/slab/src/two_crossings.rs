@@ -928,33 +928,33 @@ impl TwoCrossings {
                 p2 * -v_c.z / (r * r * -v_b.z),
             ))
         };
+        // A point of either sampler (the pair of directions it reached, if
+        // any) with the rule's weight: the integrand over the sum of the
+        // densities (the balance heuristic).
+        let mut visit = |weight: f64, dirs: Option<(DVec3, DVec3)>| {
+            if let Some((v_c, v_b)) = dirs {
+                if let Some((f, p1, p2)) = point(v_c, v_b).filter(|q| q.0 > 0.0) {
+                    add(weight * f / (p1 + p2), v_c, v_b);
+                }
+            }
+        };
         // Both samplers' micro-normals on the rule's points.
         let (n1, n2) = (m1.visible_normal_grid(wi, u), m2.visible_normal_grid(wo, u));
         for (a, wa) in w.iter().enumerate() {
             for (b, wb) in w.iter().enumerate() {
                 let k = a * u.len() + b;
                 // From `wi` through the first face.
-                if let Some(v_c) = refract(wi, n1[k], 1.0 / eta1).filter(|v| v.z < 0.0) {
-                    if let Some(v_b) = snell(v_c, 1.0 / r) {
-                        if let Some((f, p1, p2)) = point(v_c, v_b) {
-                            if f > 0.0 {
-                                add(wa * wb * f / (p1 + p2), v_c, v_b);
-                            }
-                        }
-                    }
-                }
+                let first = refract(wi, n1[k], 1.0 / eta1)
+                    .filter(|v| v.z < 0.0)
+                    .and_then(|v_c| snell(v_c, 1.0 / r).map(|v_b| (v_c, v_b)));
+                visit(wa * wb, first);
                 // From `wo` through the second face (the direction towards
                 // the light there, mirrored back to the medium's `v_b`).
-                if let Some(t) = refract(wo, n2[k], 1.0 / eta2).filter(|t| t.z < 0.0) {
-                    let v_b = DVec3::new(-t.x, -t.y, t.z);
-                    if let Some(v_c) = snell(v_b, r) {
-                        if let Some((f, p1, p2)) = point(v_c, v_b) {
-                            if f > 0.0 {
-                                add(wa * wb * f / (p1 + p2), v_c, v_b);
-                            }
-                        }
-                    }
-                }
+                let second = refract(wo, n2[k], 1.0 / eta2)
+                    .filter(|t| t.z < 0.0)
+                    .map(|t| DVec3::new(-t.x, -t.y, t.z))
+                    .and_then(|v_b| snell(v_b, r).map(|v_c| (v_c, v_b)));
+                visit(wa * wb, second);
             }
         }
     }
