@@ -306,7 +306,8 @@ fn paper_models_and_components() {
             .map(|l| l.split(',').skip(3).map(|v| v.parse().unwrap()).collect())
             .collect()
     };
-    for model in ["paper", "reduced-multilayer"] {
+    // `slab`'s single is its first-order part (since 2026-12-07; 0 before).
+    for model in ["paper", "reduced-multilayer", "slab"] {
         let all = get(model, dev_a, "all");
         let parts: Vec<Vec<Vec<f64>>> = ["surface", "single", "multiple", "direct"]
             .iter()
@@ -321,6 +322,7 @@ fn paper_models_and_components() {
             );
             assert!(row[0] >= 0.0 && row[0].is_finite());
         }
+        assert!(parts[1].iter().any(|r| r[0] > 0.0), "{model}: no single scattering");
     }
     let lg = r#"{"k_d":[0.6,0.5,0.4],"k_t":0.2,"eta":1.5,"m":0.3,"dist":"ggx"}"#;
     let (ok, out, err) = run(&[

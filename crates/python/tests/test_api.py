@@ -141,6 +141,18 @@ def test_components_sum_to_all():
     np.testing.assert_allclose(total, b.eval(wi, wo), rtol=1e-12, atol=0)
 
 
+def test_slab_components_sum_to_all():
+    # `slab` splits like `paper` (its `single` is the first-order term since
+    # 2026-12-07): the four components sum to `eval`, each is at least 0, and
+    # a scattering sheet's single is not 0.
+    b = paperbsdf.Bsdf("slab", UNEQUAL)
+    wi, wo = hard_pairs()
+    parts = {c: b.eval(wi, wo, c) for c in ("surface", "single", "multiple", "direct")}
+    np.testing.assert_allclose(sum(parts.values()), b.eval(wi, wo), rtol=1e-9, atol=1e-300)
+    assert all((v >= 0).all() for v in parts.values())
+    assert (parts["single"] > 0).any(axis=1).mean() > 0.5
+
+
 def test_sample_weight_and_pdf_agree_with_eval_and_pdf():
     for params in ("matte", "glossy", UNEQUAL):
         b = paperbsdf.PaperBsdf(params)

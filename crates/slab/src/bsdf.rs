@@ -214,8 +214,15 @@
 //! reflections and transmission through rough faces, from the albedo-0
 //! solution, and a coated front's round trip (analytic); delta lobes are
 //! not in `eval`) and
-//! [`Component::Multiple`], which here is **every scattering order**, single
-//! scattering included (`slab` does not split orders 1 and 2+).
+//! [`Component::Single`] (the light scattered once in the medium, with
+//! every face interaction around it: paths scattered `k` times carry `a^k`
+//! of the albedo `a`, so this is the first-order term `a dS/da` at `a = 0`,
+//! solved exactly with the unscattered sheet, [`crate::Prepared::solve_first_order`],
+//! crate::layer "First order") and [`Component::Multiple`] (orders 2 and up). The
+//! first-order part is a part of the table like the unscattered one, scaled
+//! by the same balance and windows, so the components sum to `eval`.
+//! Until 2026-12-07 `single` was 0 and `multiple` held every order. It is
+//! interpolated from the table, not the exact single-scattering integral.
 
 use crate::error::SlabError;
 use crate::interface::{column_albedo, walk_window};
@@ -992,6 +999,9 @@ pub struct SlabBsdf {
     table: Tables,
     /// The same for the unscattered part of the table (component `direct`).
     direct: Tables,
+    /// The same for the table's first-order part, the light scattered once
+    /// in the medium (component `single`, module doc "Components").
+    first: Tables,
     /// Delta lobes of two smooth faces.
     smooth: Option<SmoothSheet>,
     /// Bins in `mu` (uniform) and in `|phi|` (uniform on `[0, pi]`) of the sampling cells.
@@ -1347,14 +1357,15 @@ fn interpolant_weights(mu: &[f64], g: &[f64]) -> Vec<f64> {
 /// `x[exit side][o] x[side][j]`, symmetric in the pair and its reciprocal, so
 /// reciprocity is kept exactly; `x` is found by the symmetric Sinkhorn
 /// iteration `x_j <- x_j sqrt(target_j / current_j)`, after reflection
-/// and transmission were scaled apart ([`split_balance`]). `direct` (a part
-/// of `table`) is scaled by the same factors. Returns `x` per side and
+/// and transmission were scaled apart ([`split_balance`]). `parts` (parts
+/// of `table`: its unscattered and its first-order light) are scaled by the
+/// same factors. Returns `x` per side and
 /// node, and the split's factors per `[transmit][side]` and node.
 // Side, node and channel index several tables at once.
 #[allow(clippy::needless_range_loop)]
 fn balance_interpolation(
     table: &mut [[Vec<Rgb>; 2]; 2],
-    direct: &mut [[Vec<Rgb>; 2]; 2],
+    parts: &mut [[[Vec<Rgb>; 2]; 2]],
     grid: &Grid,
     cross: &[Vec<f64>; 2],
     shape: &[[Vec<f64>; 3]; 2],
@@ -1397,7 +1408,7 @@ fn balance_interpolation(
                     .collect()
             })
         });
-        let f = split_balance(table, direct, n, &target, &wi, orders, c);
+        let f = split_balance(table, parts, n, &target, &wi, orders, c);
         for (t, per_side) in f.iter().enumerate() {
             for (s, v) in per_side.iter().enumerate() {
                 for (j, x) in v.iter().enumerate() {
@@ -1429,23 +1440,23 @@ fn balance_interpolation(
             }
         }
     }
-    scale_pairs(table, direct, n, orders, |s, exit, o, j| {
+    scale_pairs(table, parts, n, orders, |s, exit, o, j| {
         Rgb(std::array::from_fn(|c| x[o][exit][c] * x[j][s][c]))
     });
     ([0, 1].map(|s| x.iter().map(|xj| Rgb(xj[s])).collect()), split)
 }
 
 /// Multiplies every order of the node pair `(o, j)` (`wo` at node `o` on
-/// side `exit`, `wi` at node `j` on side `s`) in `table` and its part
-/// `direct` by `factor(s, exit, o, j)`, per channel.
+/// side `exit`, `wi` at node `j` on side `s`) in `table` and its `parts`
+/// by `factor(s, exit, o, j)`, per channel.
 fn scale_pairs(
     table: &mut [[Vec<Rgb>; 2]; 2],
-    direct: &mut [[Vec<Rgb>; 2]; 2],
+    parts: &mut [[[Vec<Rgb>; 2]; 2]],
     n: usize,
     orders: usize,
     factor: impl Fn(usize, usize, usize, usize) -> Rgb,
 ) {
-    for tab in [table, direct] {
+    for tab in std::iter::once(table).chain(parts.iter_mut()) {
         for (s, per_side) in tab.iter_mut().enumerate() {
             for (t, pairs) in per_side.iter_mut().enumerate() {
                 let exit = if t == 1 { 1 - s } else { s };
@@ -1488,7 +1499,7 @@ const SPLIT_SWEEPS: usize = 100;
 /// quadrature's weights differ), which the common factors then close.
 fn split_balance(
     table: &mut [[Vec<Rgb>; 2]; 2],
-    direct: &mut [[Vec<Rgb>; 2]; 2],
+    parts: &mut [[[Vec<Rgb>; 2]; 2]],
     n: usize,
     target: &[[Vec<f64>; 2]; 2],
     wi: &[Vec<f64>; 2],
@@ -1522,7 +1533,7 @@ fn split_balance(
             }
         }
     }
-    scale_pairs(table, direct, n, orders, |s, exit, o, j| {
+    scale_pairs(table, parts, n, orders, |s, exit, o, j| {
         let t = usize::from(exit != s);
         let k = f[t][exit][o] * f[t][s][j];
         Rgb(std::array::from_fn(|ch| if ch == c { k } else { 1.0 }))
@@ -1836,7 +1847,7 @@ const RING_ENERGY_TOLERANCE: f64 = 1e-6;
 /// see) to every node pair whose series in `table` (what `eval` sums and
 /// clamps) rings below zero by more than [`RING_ENERGY_TOLERANCE`] in any of
 /// the first `ks` channels, and to its reciprocal pair, in `table` and in
-/// its part `direct` alike (reflection `(o, j)` and
+/// its `parts` alike (reflection `(o, j)` and
 /// `(j, o)` from the same side, transmission `(o, j)` from one side and
 /// `(j, o)` from the other). `eval` clamps the sum at 0, which adds the
 /// negative part's energy; Fejer's sum of a non-negative function's orders
@@ -1851,7 +1862,7 @@ const RING_ENERGY_TOLERANCE: f64 = 1e-6;
 /// resolution (Fejer's kernel, about `2 pi / M` wide).
 fn fejer_where_ringing(
     table: &mut [[Vec<Rgb>; 2]; 2],
-    direct: &mut [[Vec<Rgb>; 2]; 2],
+    parts: &mut [[[Vec<Rgb>; 2]; 2]],
     q: &[f64],
     orders: [[usize; 2]; 2],
     solved: usize,
@@ -1901,9 +1912,10 @@ fn fejer_where_ringing(
                 })
                 .collect();
             for (o, j) in flagged {
-                for tab in [&mut *table, &mut *direct] {
+                for tab in std::iter::once(&mut *table).chain(parts.iter_mut()) {
                     for (ss, tt, pp) in [(s, t, o * n + j), (rs, rt, j * n + o)] {
-                        let l = orders[ss][tt];
+                        // Each table's own orders (a part may stop at `solved`).
+                        let l = tab[ss][tt].len() / (n * n);
                         for (m, v) in tab[ss][tt][pp * l..(pp + 1) * l].iter_mut().enumerate() {
                             let w = (1.0 - m as f64 / solved as f64).max(0.0);
                             *v = v.map(|x| x * w);
@@ -2621,18 +2633,19 @@ impl SlabBsdf {
         };
         let prepared = specs[0].prepare(&disc)?;
         let both_smooth = paper.face_is_smooth(Side::Front) && paper.face_is_smooth(Side::Back);
-        // Solve each distinct channel: (full, unscattered).
-        // Each distinct medium solved once, with and without scattering;
+        // Each distinct medium solved once with its scattering, once
+        // without, with the slope in the albedo (the first-order term,
+        // module doc "Components"): (full, unscattered, slope, albedo);
         // `solution_of[c]` is channel c's.
-        let mut solutions: Vec<(Solution, Solution)> = Vec::new();
+        let mut solutions: Vec<(Solution, Solution, Solution, f64)> = Vec::new();
         let mut solution_of = [0usize; 3];
         for (c, spec) in specs.iter().enumerate() {
             solution_of[c] = match (0..c).find(|&k| specs[k].medium == spec.medium) {
                 Some(k) => solution_of[k],
                 None => {
                     let full = prepared.solve(spec.medium.albedo, spec.medium.tau)?;
-                    let unscattered = prepared.solve(0.0, spec.medium.tau)?;
-                    solutions.push((full, unscattered));
+                    let (unscattered, slope) = prepared.solve_first_order(spec.medium.tau)?;
+                    solutions.push((full, unscattered, slope, spec.medium.albedo));
                     solutions.len() - 1
                 }
             };
@@ -2715,7 +2728,7 @@ impl SlabBsdf {
         };
         let mut unscattered: Vec<Option<TwoCrossings>> = Vec::new();
         let mut unscattered_proj: Vec<[Vec<DMatrix<f64>>; 2]> = Vec::new();
-        for (k, (_, unsc)) in solutions.iter().enumerate() {
+        for (k, (_, unsc, _, _)) in solutions.iter().enumerate() {
             let tau = tau_of(k);
             let term = terms.iter().find(|t| t.between() == Between::Straight { tau }).cloned();
             let proj = match term {
@@ -2905,7 +2918,9 @@ impl SlabBsdf {
         // A grey sheet: every channel is the same solution.
         let grey = solution_of.iter().all(|&k| k == solution_of[0]);
         let mut table: [[Vec<Rgb>; 2]; 2] = Default::default();
-        let mut direct: [[Vec<Rgb>; 2]; 2] = Default::default();
+        // The table's parts: [unscattered (component `direct`), first order
+        // (component `single`)].
+        let mut parts: [[[Vec<Rgb>; 2]; 2]; 2] = Default::default();
         // The walk's reflection past the solution's orders, per side: orders
         // `m_solved..m_count` of each node pair, the same in the table and
         // its unscattered part (`extra_len` per pair).
@@ -2923,11 +2938,13 @@ impl SlabBsdf {
             for (t, transmit) in [false, true].into_iter().enumerate() {
                 let mut tab = vec![Rgb::ZERO; n * n * m_solved];
                 let mut dir = vec![Rgb::ZERO; n * n * m_solved];
+                let mut first = vec![Rgb::ZERO; n * n * m_solved];
                 for (c, &k) in solution_of.iter().enumerate() {
-                    let (full, unsc) = &solutions[k];
+                    let (full, unsc, slope, albedo) = &solutions[k];
                     for m in 0..m_solved {
                         let eps = if m == 0 { 1.0 } else { 2.0 };
                         let (kf, ku) = (block(full, side, transmit, m), block(unsc, side, transmit, m));
+                        let ks = block(slope, side, transmit, m);
                         let walk = walk_r.get(m).filter(|_| !transmit);
                         for o in 0..n {
                             for j in 0..n {
@@ -2951,20 +2968,25 @@ impl SlabBsdf {
                                 // At normal incidence or exit (the node mu = 1)
                                 // nothing depends on azimuth: orders m >= 1
                                 // vanish (the projection leaves rounding there).
-                                let (vt, vd) = if m > 0 && (o == n - 1 || j == n - 1) {
-                                    (0.0, 0.0)
+                                // The first order: the slope times the albedo
+                                // (the faces' own terms have none).
+                                let v1 = ks[(o, j)] * albedo;
+                                let (vt, vd, v1) = if m > 0 && (o == n - 1 || j == n - 1) {
+                                    (0.0, 0.0, 0.0)
                                 } else {
-                                    (vt, vd)
+                                    (vt, vd, v1)
                                 };
                                 let idx = (o * n + j) * m_solved + m;
                                 tab[idx].0[c] = vt * scale;
                                 dir[idx].0[c] = vd * scale;
+                                first[idx].0[c] = v1 * scale;
                             }
                         }
                     }
                 }
                 table[side][t] = tab;
-                direct[side][t] = dir;
+                parts[0][side][t] = dir;
+                parts[1][side][t] = first;
             }
             if extra_len == 0 {
                 continue;
@@ -3033,7 +3055,7 @@ impl SlabBsdf {
                 }
                 let high = &extra[side][p * extra_len..(p + 1) * extra_len];
                 let change: Vec<f64> = (0..m_count).map(|m| to_fejer(o, j, m)).collect();
-                let series: Vec<Vec<Rgb>> = [&table[side][0], &direct[side][0]]
+                let series: Vec<Vec<Rgb>> = [&table[side][0], &parts[0][side][0]]
                     .iter()
                     .map(|tab| {
                         tab[p * m_solved..(p + 1) * m_solved]
@@ -3084,8 +3106,9 @@ impl SlabBsdf {
                     for m in 1..m_count {
                         let d = Rgb::splat(sh * to_fejer(o, j, m));
                         if m < m_solved {
+                            // The walk's light is unscattered in the medium.
                             table[side][0][p * m_solved + m] += d;
-                            direct[side][0][p * m_solved + m] += d;
+                            parts[0][side][0][p * m_solved + m] += d;
                         } else {
                             extra[side][p * extra_len + m - m_solved] += d;
                         }
@@ -3097,9 +3120,9 @@ impl SlabBsdf {
         // the lit face lets in, `1 - r`, with `r` what `eval` adds analytically.
         let linear_shape = [Side::Front, Side::Back].map(|side| crossing_shape(&g.mu, |m| face_r_at(side, m)));
         let mut shape = linear_shape.clone().map(|g| [g.clone(), g.clone(), g]);
-        let unbalanced = (table.clone(), direct.clone());
+        let unbalanced = (table.clone(), parts.clone());
         let (mut balance, mut split) =
-            balance_interpolation(&mut table, &mut direct, g, &cross, &shape, &adjust, m_solved);
+            balance_interpolation(&mut table, &mut parts, g, &cross, &shape, &adjust, m_solved);
         // The triangles' albedo between the nodes of `mu_i` (ridge_ratios),
         // folded into the crossing shapes, which changes the exit weights of
         // the balance: the solution rebalanced, a few passes.
@@ -3112,8 +3135,8 @@ impl SlabBsdf {
                     }
                 }
             }
-            (table, direct) = unbalanced.clone();
-            (balance, split) = balance_interpolation(&mut table, &mut direct, g, &cross, &shape, &adjust, m_solved);
+            (table, parts) = unbalanced.clone();
+            (balance, split) = balance_interpolation(&mut table, &mut parts, g, &cross, &shape, &adjust, m_solved);
         }
         // The walk's orders past the solution's, balanced as the rest of
         // their pairs (factors x_o x_j and the reflection's split factors on the lit side), joined to the
@@ -3139,16 +3162,20 @@ impl SlabBsdf {
                         })
                         .collect()
                 };
+                // The first-order part keeps the solution's orders: the
+                // walk's light is unscattered in the medium.
                 table[side][0] = join(&table[side][0]);
-                direct[side][0] = join(&direct[side][0]);
+                parts[0][side][0] = join(&parts[0][side][0]);
                 orders[side][0] = m_count;
             }
         }
         let q: Vec<f64> = (0..n).map(|o| 2.0 * PI * g.w[o] * g.mu[o]).collect();
-        fejer_where_ringing(&mut table, &mut direct, &q, orders, m_solved, if grey { 1 } else { 3 });
-        let (mut table, mut direct) = (
+        fejer_where_ringing(&mut table, &mut parts, &q, orders, m_solved, if grey { 1 } else { 3 });
+        let [direct, first] = parts;
+        let (mut table, mut direct, mut first) = (
             Tables::truncate(table, n, orders, grey, m_solved, true),
             Tables::truncate(direct, n, orders, grey, m_solved, false),
+            Tables::truncate(first, n, [[m_solved; 2]; 2], grey, m_solved, false),
         );
         // Per node of an interval where the orders follow the sine law
         // (`SlabBsdf::law_ratio_of`, intervals `law_from..n - 2`): `sin theta`
@@ -3167,6 +3194,7 @@ impl SlabBsdf {
             .collect();
         table.limit_law(n, &reach);
         direct.limit_law(n, &reach);
+        first.limit_law(n, &reach);
         let smooth = both_smooth.then(|| SmoothSheet {
             eta_f: specs[0].front.eta(),
             eta_b: specs[0].back.eta(),
@@ -3196,6 +3224,7 @@ impl SlabBsdf {
             law_from,
             table,
             direct,
+            first,
             smooth,
             mu_bins: opts.mu_bins,
             phi_bins: opts.phi_bins,
@@ -3471,7 +3500,7 @@ impl SlabBsdf {
 
     /// Memory held by the tables and sampling densities, in bytes.
     pub fn memory_bytes(&self) -> usize {
-        let tables: usize = [&self.table, &self.direct]
+        let tables: usize = [&self.table, &self.direct, &self.first]
             .iter()
             .map(|t| {
                 t.c.iter()
@@ -3790,12 +3819,13 @@ impl SlabBsdf {
         (Rgb::splat(r), t)
     }
 
-    /// The table at `(wi, wo)` and its unscattered part, each clamped at 0
-    /// as `eval` clamps the table.
-    fn table_parts(&self, wi: DVec3, wo: DVec3) -> (Rgb, Rgb) {
+    /// The table at `(wi, wo)`, its unscattered part and its first-order
+    /// part, each clamped at 0 as `eval` clamps the table.
+    fn table_parts(&self, wi: DVec3, wo: DVec3) -> (Rgb, Rgb, Rgb) {
         (
             self.eval_table(&self.table, wi, wo).map(|x| x.max(0.0)),
             self.eval_table(&self.direct, wi, wo).map(|x| x.max(0.0)),
+            self.eval_table(&self.first, wi, wo).map(|x| x.max(0.0)),
         )
     }
 
@@ -3937,16 +3967,26 @@ impl ComponentModel for SlabBsdf {
             // each was clamped on its own, and their sum exceeded `eval`
             // there: a thin sheet between GGX 0.01 faces near the normal).
             Component::Direct => {
-                let (whole, part) = self.table_parts(wi, wo);
+                let (whole, part, _) = self.table_parts(wi, wo);
                 Rgb(std::array::from_fn(|k| part.0[k].min(whole.0[k])))
                     + Rgb::splat(self.coat_at(wi, wo))
                     + self.unscattered_at(wi, wo)
             }
-            Component::Multiple => {
-                let (whole, part) = self.table_parts(wi, wo);
-                Rgb(std::array::from_fn(|k| whole.0[k] - part.0[k].min(whole.0[k])))
+            // The first-order part, clamped at what the unscattered part
+            // leaves of the whole; the rest is `multiple`.
+            Component::Single => {
+                let (whole, part, first) = self.table_parts(wi, wo);
+                Rgb(std::array::from_fn(|k| {
+                    first.0[k].min(whole.0[k] - part.0[k].min(whole.0[k]))
+                }))
             }
-            Component::Single => Rgb::ZERO,
+            Component::Multiple => {
+                let (whole, part, first) = self.table_parts(wi, wo);
+                Rgb(std::array::from_fn(|k| {
+                    let rest = whole.0[k] - part.0[k].min(whole.0[k]);
+                    rest - first.0[k].min(rest)
+                }))
+            }
         }
     }
 
@@ -3955,7 +3995,12 @@ impl ComponentModel for SlabBsdf {
     }
 
     fn components(&self) -> &'static [Component] {
-        &[Component::Surface, Component::Multiple, Component::Direct]
+        &[
+            Component::Surface,
+            Component::Single,
+            Component::Multiple,
+            Component::Direct,
+        ]
     }
 }
 

@@ -40,7 +40,8 @@
 //! of the exact integrals, since 2026-12-06), the
 //! delta lobes of smooth sheets in closed form, the rest interpolated from
 //! the Fourier tables; `eval`, `sample`, `pdf` (chi-square tested),
-//! components.
+//! components (`single`, the light scattered once, since 2026-12-07: the
+//! solution's slope in the albedo, [`Prepared::solve_first_order`]).
 //!
 //! Measured (tests/): reciprocity to 2e-14 in every order (and of the
 //! interpolated BSDF), `R + T = 1` to 1e-10 for conservative sheets with
@@ -80,9 +81,12 @@
 //! 85 degrees (summed to its own 256 orders since 2026-12-05,
 //! [`interface`]: at 75 degrees within 0.001% of twice the orders, 4.6-6.2%
 //! before; at 85 R -85 luster 1.2%, where the pairs beyond 82 degrees take
-//! part of Fejer's weights); exact single scattering as its own term (the tables
-//! hold every scattering order, so `slab` has no separate `single`
-//! component); the flank of the walk's forward peak
+//! part of Fejer's weights); exact single scattering as an analytic term
+//! (since 2026-12-07 the first-order term is solved exactly on the grid,
+//! [`Prepared::solve_first_order`], and is the component `single`, but it
+//! is interpolated from a table like the rest: an index-matched sheet's
+//! `single` is within 0.27% of the closed form at the nodes away from
+//! grazing and 1.4% at the first node, tests/first_order.rs); the flank of the walk's forward peak
 //! at grazing angles off a Beckmann 0.15 face, interpolated linearly in
 //! `mu_o` between 32 nodes (luster at 75 R -65: 0.34% from twice the
 //! nodes; at the nodes themselves within 0.04%).

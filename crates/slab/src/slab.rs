@@ -36,7 +36,7 @@ use crate::interface::{
     column_albedo, face_interface, smooth_boundary, walk_orders_for, Compensation, ProjectedFace, Projection,
     DEFAULT_AZIMUTH_POINTS,
 };
-use crate::layer::{default_start_thickness, medium_layer, Layer};
+use crate::layer::{default_start_thickness, medium_layer, medium_slope, Layer};
 use crate::phase::{phase_fourier, validate, PhaseFourier};
 use crate::quad::Grid;
 use paperbsdf_core::dielectric::{Interface, ETA_RANGE, M_RANGE};
@@ -427,6 +427,53 @@ impl Prepared {
             phase_scale: self.phase.scale.clone(),
             face_compensation: [front.compensation.clone(), back.compensation.clone()],
         })
+    }
+}
+
+impl Prepared {
+    /// The sheet without scattering (the same as [`Prepared::solve`] with
+    /// albedo 0, to the last bit) and its slope in the albedo at 0, per unit
+    /// albedo: `dS/da`, whose product with the albedo is the light
+    /// scattered once in the medium, with every face interaction around it
+    /// (crate::layer, "First order"). Returned as two solutions on the same
+    /// grids; the slope's `medium` is the medium's slope.
+    pub fn solve_first_order(&self, tau: f64) -> Result<(Solution, Solution), SlabError> {
+        let [front, back] = &self.faces;
+        let solved: Vec<[Layer; 4]> = (0..self.orders)
+            .into_par_iter()
+            .map(|m| {
+                let (med, _) = medium_layer(&self.inside, &self.phase, m, 0.0, tau, self.start)?;
+                let med = med.into_layer();
+                let d_med = medium_slope(&self.inside, &self.phase, m, tau, self.start)?.into_layer();
+                let top = match &self.coating {
+                    Some(c) => &c.front[m],
+                    None => &front.orders[m],
+                };
+                let flat = |l: &Layer| Layer::zero_slope(l.n_top(), l.n_bot());
+                let (upper, d_upper) = top.add_with_slope(&flat(top), &med, &d_med)?;
+                let bottom = back.orders[m].flipped();
+                let (sheet, d_sheet) = upper.add_with_slope(&d_upper, &bottom, &flat(&bottom))?;
+                Ok([sheet, med, d_sheet, d_med])
+            })
+            .collect::<Result<_, SlabError>>()?;
+        let mut parts: [Vec<Layer>; 4] = Default::default();
+        for layers in solved {
+            for (v, l) in parts.iter_mut().zip(layers) {
+                v.push(l);
+            }
+        }
+        let [orders, medium, d_orders, d_medium] = parts;
+        let solution = |orders, medium| Solution {
+            outside: self.outside.clone(),
+            inside: self.inside.clone(),
+            coating: self.coating.as_ref().map(|c| c.grid.clone()),
+            orders,
+            medium,
+            doublings: 0,
+            phase_scale: self.phase.scale.clone(),
+            face_compensation: [front.compensation.clone(), back.compensation.clone()],
+        };
+        Ok((solution(orders, medium), solution(d_orders, d_medium)))
     }
 }
 
