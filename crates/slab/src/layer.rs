@@ -105,6 +105,13 @@ impl Layer {
     }
     /// This layer above `below`, by the adding equations (module doc).
     pub fn add(&self, below: &Layer) -> Result<Layer, SlabError> {
+        let gap = self.gap(below)?;
+        Ok(self.sum(below, &gap))
+    }
+    /// The interreflection between this layer and `below` (module doc):
+    /// `I - R1b R2t` and `I - R2t R1b`, and the light through the gap going
+    /// down, `x1 = (I - R1b R2t)^-1 T1d`, and up, `x2 = (I - R2t R1b)^-1 T2u`.
+    fn gap(&self, below: &Layer) -> Result<Gap, SlabError> {
         if self.n_bot() != below.n_top() {
             return Err(SlabError::GridMismatch {
                 upper: self.n_bot(),
@@ -113,16 +120,20 @@ impl Layer {
         }
         let n = self.n_bot();
         let eye = DMatrix::<f64>::identity(n, n);
-        // light going down through the gap between the layers
-        let x1 = solve_gap(&eye - &self.r_bot * &below.r_top, &self.t_down)?;
-        // light going up through the gap
-        let x2 = solve_gap(&eye - &below.r_top * &self.r_bot, &below.t_up)?;
-        Ok(Layer {
-            r_top: &self.r_top + &self.t_up * (&below.r_top * &x1),
-            t_down: &below.t_down * &x1,
-            r_bot: &below.r_bot + &below.t_down * (&self.r_bot * &x2),
-            t_up: &self.t_up * &x2,
-        })
+        let down = &eye - &self.r_bot * &below.r_top;
+        let up = &eye - &below.r_top * &self.r_bot;
+        let x1 = solve_gap(down.clone(), &self.t_down)?;
+        let x2 = solve_gap(up.clone(), &below.t_up)?;
+        Ok(Gap { down, up, x1, x2 })
+    }
+    /// This layer above `below` from their [`Layer::gap`].
+    fn sum(&self, below: &Layer, gap: &Gap) -> Layer {
+        Layer {
+            r_top: &self.r_top + &self.t_up * (&below.r_top * &gap.x1),
+            t_down: &below.t_down * &gap.x1,
+            r_bot: &below.r_bot + &below.t_down * (&self.r_bot * &gap.x2),
+            t_up: &self.t_up * &gap.x2,
+        }
     }
 }
 
@@ -150,41 +161,37 @@ impl Layer {
         below: &Layer,
         below_slope: &Slope,
     ) -> Result<(Layer, Slope), SlabError> {
-        if self.n_bot() != below.n_top() {
-            return Err(SlabError::GridMismatch {
-                upper: self.n_bot(),
-                lower: below.n_top(),
-            });
-        }
-        let n = self.n_bot();
-        let eye = DMatrix::<f64>::identity(n, n);
-        let gap1 = &eye - &self.r_bot * &below.r_top;
-        let gap2 = &eye - &below.r_top * &self.r_bot;
-        let x1 = solve_gap(gap1.clone(), &self.t_down)?;
-        let x2 = solve_gap(gap2.clone(), &below.t_up)?;
+        let gap = self.gap(below)?;
+        let (x1, x2) = (&gap.x1, &gap.x2);
         // d x1 = gap1^-1 (dT1d + (dR1b R2t + R1b dR2t) x1), and alike x2.
         let d_gap1 = &slope.r_bot * &below.r_top + &self.r_bot * &below_slope.r_top;
-        let dx1 = solve_gap(gap1, &(&slope.t_down + &d_gap1 * &x1))?;
+        let dx1 = solve_gap(gap.down.clone(), &(&slope.t_down + &d_gap1 * x1))?;
         let d_gap2 = &below_slope.r_top * &self.r_bot + &below.r_top * &slope.r_bot;
-        let dx2 = solve_gap(gap2, &(&below_slope.t_up + &d_gap2 * &x2))?;
-        let r2t_x1 = &below.r_top * &x1;
-        let r1b_x2 = &self.r_bot * &x2;
+        let dx2 = solve_gap(gap.up.clone(), &(&below_slope.t_up + &d_gap2 * x2))?;
         let d_slope = Layer {
-            r_top: &slope.r_top + &slope.t_up * &r2t_x1 + &self.t_up * (&below_slope.r_top * &x1 + &below.r_top * &dx1),
-            t_down: &below_slope.t_down * &x1 + &below.t_down * &dx1,
+            r_top: &slope.r_top
+                + &slope.t_up * (&below.r_top * x1)
+                + &self.t_up * (&below_slope.r_top * x1 + &below.r_top * &dx1),
+            t_down: &below_slope.t_down * x1 + &below.t_down * &dx1,
             r_bot: &below_slope.r_bot
-                + &below_slope.t_down * &r1b_x2
-                + &below.t_down * (&slope.r_bot * &x2 + &self.r_bot * &dx2),
-            t_up: &slope.t_up * &x2 + &self.t_up * &dx2,
+                + &below_slope.t_down * (&self.r_bot * x2)
+                + &below.t_down * (&slope.r_bot * x2 + &self.r_bot * &dx2),
+            t_up: &slope.t_up * x2 + &self.t_up * &dx2,
         };
-        let sum = Layer {
-            r_top: &self.r_top + &self.t_up * r2t_x1,
-            t_down: &below.t_down * &x1,
-            r_bot: &below.r_bot + &below.t_down * r1b_x2,
-            t_up: &self.t_up * &x2,
-        };
-        Ok((sum, d_slope))
+        Ok((self.sum(below, &gap), d_slope))
     }
+}
+
+/// [`Layer::gap`]: the interreflection matrices and the light through the gap.
+struct Gap {
+    /// `I - R1b R2t`.
+    down: DMatrix<f64>,
+    /// `I - R2t R1b`.
+    up: DMatrix<f64>,
+    /// `(I - R1b R2t)^-1 T1d`.
+    x1: DMatrix<f64>,
+    /// `(I - R2t R1b)^-1 T2u`.
+    x2: DMatrix<f64>,
 }
 
 /// Solves `gap x = rhs` for an interreflection matrix `gap = I - R_a R_b`.
