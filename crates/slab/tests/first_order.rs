@@ -20,17 +20,12 @@ use paperbsdf_core::{Bsdf, DVec3, PaperParams};
 use paperbsdf_slab::{Discretisation, Layer, Side, SlabBsdf, SlabSpec};
 use std::f64::consts::PI;
 
+mod support;
+
+use support::thin_coated_sheet;
+
 fn sheet(json: &str) -> PaperParams {
     serde_json::from_str(json).unwrap()
-}
-
-/// A thin coated sheet with unequal rough faces (GGX 0.3 front of index
-/// 1.5 over a base of 1.4, GGX 0.15 back; tau 1.8), `face_scattering`
-/// "multiple" (the default).
-fn thin_coated() -> PaperParams {
-    sheet(
-        r#"{"d":0.03,"sigma_a":0.5,"sigma_s":60,"g_f":0.6,"g_b":-0.3,"w_b":0.2,"eta_f":1.5,"eta_b":1.4,"m_f":0.3,"m_b":0.15,"dist_f":"ggx","dist_b":"ggx"}"#,
-    )
 }
 
 /// A paper-like sheet of moderate thickness (tau 4.5) with a Beckmann 0.15
@@ -63,7 +58,7 @@ fn relative_difference(a: &Layer, b: &Layer) -> f64 {
 /// solve exactly.
 #[test]
 fn slope_is_the_derivative_of_the_solver() {
-    for p in [thin_coated(), paper_like()] {
+    for p in [thin_coated_sheet(), paper_like()] {
         let spec = SlabSpec::from_params(&p, 0).unwrap();
         let disc = Discretisation {
             orders: 8,
@@ -233,7 +228,7 @@ fn index_matched_single_is_the_closed_form() {
 #[test]
 fn single_and_multiple_match_the_simulator() {
     use paperbsdf_sim::{simulate_bsdf, SimConfig, Slab};
-    for (name, p) in [("thin coated", thin_coated()), ("paper-like", paper_like())] {
+    for (name, p) in [("thin coated", thin_coated_sheet()), ("paper-like", paper_like())] {
         let model = SlabBsdf::new(&p).unwrap();
         let sim = Slab::from_params(&p).unwrap();
         for ti in [0.0, 60.0] {

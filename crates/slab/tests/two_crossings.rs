@@ -17,6 +17,7 @@ use paperbsdf_slab::two_crossings::{Between, TwoCrossings, TABLE_POINTS};
 mod support;
 
 use support::lobe_points::{dir, POINTS};
+use support::thin_coated_sheet;
 
 /// A term of either kind and what the brute force needs to integrate it.
 struct Case {
@@ -532,17 +533,6 @@ fn thin_sheet_converges_near_the_normal() {
         .into_iter()
         .flat_map(|ti| [-15.0, -9.0, -6.5, -3.0, 0.0, 2.5, 6.5, 10.0, 15.0].map(|to| (ti, to)));
     largest_change_with_twice_the_nodes(&p, pairs, true, 2.5e-2);
-}
-
-/// The coated sheet of `tests/cli_refine.rs` (a thin sheet, optical
-/// thickness 1.8, a GGX 0.3 front of index 1.5 over a base of 1.4 with a
-/// GGX 0.15 back): fitted papers have a front and a base of different
-/// indices (docs/fit_table.md), and thin ones light through.
-fn thin_coated_sheet() -> PaperParams {
-    serde_json::from_str(
-        r#"{"d":0.03,"sigma_a":0.5,"sigma_s":60,"g_f":0.6,"g_b":-0.3,"w_b":0.2,"eta_f":1.5,"eta_b":1.4,"m_f":0.3,"m_b":0.15,"dist_f":"ggx","dist_b":"ggx"}"#,
-    )
-    .unwrap()
 }
 
 /// The unscattered transmission of a coated sheet, through its boundary

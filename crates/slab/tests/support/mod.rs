@@ -3,7 +3,8 @@
 //! deterministic rule for the integral of a BSDF over the outgoing
 //! direction, a sheet built with the default and with `k` times the nodes, and
 //! the directions around the lobes of `two_crossings` ([`lobe_points`]),
-//! and a sheet given two alike faces ([`with_both_faces`]).
+//! a sheet given two alike faces ([`with_both_faces`]), and a thin coated
+//! sheet ([`thin_coated_sheet`]).
 #![allow(dead_code)]
 
 pub mod lobe_points;
@@ -129,4 +130,16 @@ pub fn with_both_faces(p: PaperParams, eta: f64, m: f64, dist: Distribution) -> 
         dist_b: dist,
         ..p
     }
+}
+
+/// The coated sheet of `tests/cli_refine.rs` (a thin sheet, optical
+/// thickness 1.8, a GGX 0.3 front of index 1.5 over a base of 1.4 with a
+/// GGX 0.15 back; `face_scattering` "multiple"): fitted papers have a front
+/// and a base of different indices (docs/fit_table.md), and thin ones light
+/// through.
+pub fn thin_coated_sheet() -> PaperParams {
+    serde_json::from_str(
+        r#"{"d":0.03,"sigma_a":0.5,"sigma_s":60,"g_f":0.6,"g_b":-0.3,"w_b":0.2,"eta_f":1.5,"eta_b":1.4,"m_f":0.3,"m_b":0.15,"dist_f":"ggx","dist_b":"ggx"}"#,
+    )
+    .unwrap()
 }
