@@ -14,7 +14,10 @@
 //! Printed per sheet: the largest relative change of a value (with the
 //! in-plane point where it happens), the largest within 5 degrees of the
 //! normal (either direction), from 5 to 15 degrees, and further out, the RMS
-//! relative change, and the largest change of the albedo. Values below
+//! relative change, and the largest change of the albedo; and at the point
+//! of the largest change, how much each component (`surface`, `single`,
+//! `multiple`, `direct`) moves, so that the component to improve is named
+//! (since 2026-12-07, when `slab` got its `single`). Values below
 //! `1e-3` of the sheet's largest in-plane value are left out of the relative
 //! change (the far tails of a narrow lobe, where a relative change says
 //! nothing a renderer sees).
@@ -31,6 +34,7 @@
 
 use paperbsdf_core::bsdf::albedo_from;
 use paperbsdf_core::geometry::in_plane_directions;
+use paperbsdf_core::models::ComponentModel;
 use paperbsdf_core::{Bsdf, FaceScattering, PaperParams};
 use paperbsdf_slab::{SlabBsdf, SlabOptions};
 
@@ -200,6 +204,23 @@ fn main() {
                     100.0 * bands[2],
                     100.0 * (sum / n as f64).sqrt(),
                     da
+                );
+                // What each component moves at that point.
+                let (ti, tr, to) = where_;
+                let (wi, wo) = in_plane_directions(ti, to, tr);
+                let moves: Vec<String> = b0
+                    .components()
+                    .iter()
+                    .map(|&c| {
+                        let d = b1.eval_component(wi, wo, c).mean() - b0.eval_component(wi, wo, c).mean();
+                        format!("{} {d:+.2e}", c.name())
+                    })
+                    .collect();
+                println!(
+                    "{:8} {name:14} {vname:9}: there the value moves by {:+.2e}: {}",
+                    faces.name(),
+                    b1.eval(wi, wo).mean() - b0.eval(wi, wo).mean(),
+                    moves.join(", ")
                 );
             }
         }
