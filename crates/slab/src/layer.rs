@@ -307,12 +307,7 @@ pub fn medium_layer(
             0,
         ));
     }
-    let mut k = 0u32;
-    let mut dtau = tau;
-    while dtau > start {
-        dtau *= 0.5;
-        k += 1;
-    }
+    let (dtau, k) = start_and_doublings(tau, start);
     let h = 0.5 * dtau;
     let eye = DMatrix::<f64>::identity(n, n);
     // hA and hB as in the module doc
@@ -364,12 +359,7 @@ pub fn medium_slope(
             t: DMatrix::zeros(n, n),
         });
     }
-    let mut dtau = tau;
-    let mut k = 0u32;
-    while dtau > start {
-        dtau *= 0.5;
-        k += 1;
-    }
+    let (dtau, k) = start_and_doublings(tau, start);
     let h = 0.5 * dtau;
     // x = h / mu: X = diag(1 / (1 + x)), X Y = diag((1 - x) / (1 + x)),
     // I + X Y = diag(2 / (1 + x)). The starting layer's first order:
@@ -392,6 +382,19 @@ pub fn medium_slope(
         }
     }
     Ok(SymmetricLayer { r, t })
+}
+
+/// The starting layer's thickness for `tau`, `tau / 2^k` with the fewest
+/// halvings `k` that bring it to at most `start`, and `k`: the same for
+/// [`medium_layer`] and [`medium_slope`], whose doublings must match.
+fn start_and_doublings(tau: f64, start: f64) -> (f64, u32) {
+    let mut k = 0u32;
+    let mut dtau = tau;
+    while dtau > start {
+        dtau *= 0.5;
+        k += 1;
+    }
+    (dtau, k)
 }
 
 /// The checks of [`medium_layer`] and [`medium_slope`] but the albedo's.

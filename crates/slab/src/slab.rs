@@ -401,23 +401,33 @@ impl Prepared {
     /// `[0, 1]` and optical thickness `tau` (the grids, phase function and
     /// faces (and coating) of [`SlabSpec::prepare`]): Fourier orders in parallel.
     pub fn solve(&self, albedo: f64, tau: f64) -> Result<Solution, SlabError> {
-        let [front, back] = &self.faces;
         let solved: Vec<(Layer, Layer, u32)> = (0..self.orders)
             .into_par_iter()
             .map(|m| {
                 let (med, k) = medium_layer(&self.inside, &self.phase, m, albedo, tau, self.start)?;
                 let med = med.into_layer();
-                let top = match &self.coating {
-                    Some(c) => &c.front[m],
-                    None => &front.orders[m],
-                };
-                let sheet = top.add(&med)?.add(&back.orders[m].flipped())?;
+                let sheet = self.top(m).add(&med)?.add(&self.faces[1].orders[m].flipped())?;
                 Ok((sheet, med, k))
             })
             .collect::<Result<_, SlabError>>()?;
         let doublings = solved.first().map_or(0, |s| s.2);
         let (orders, medium): (Vec<Layer>, Vec<Layer>) = solved.into_iter().map(|(a, b, _)| (a, b)).unzip();
-        Ok(Solution {
+        Ok(self.solution(orders, medium, doublings))
+    }
+
+    /// The layer above the medium in order `m`: the front face, or a coated
+    /// front's rough interface over its coating.
+    fn top(&self, m: usize) -> &Layer {
+        match &self.coating {
+            Some(c) => &c.front[m],
+            None => &self.faces[0].orders[m],
+        }
+    }
+
+    /// A solution on these grids from its orders and medium layers.
+    fn solution(&self, orders: Vec<Layer>, medium: Vec<Layer>, doublings: u32) -> Solution {
+        let [front, back] = &self.faces;
+        Solution {
             outside: self.outside.clone(),
             inside: self.inside.clone(),
             coating: self.coating.as_ref().map(|c| c.grid.clone()),
@@ -426,11 +436,9 @@ impl Prepared {
             doublings,
             phase_scale: self.phase.scale.clone(),
             face_compensation: [front.compensation.clone(), back.compensation.clone()],
-        })
+        }
     }
-}
 
-impl Prepared {
     /// The sheet without scattering (the same as [`Prepared::solve`] with
     /// albedo 0, to the last bit) and its slope in the albedo at 0, per unit
     /// albedo: `dS/da`, whose product with the albedo is the light
@@ -438,20 +446,16 @@ impl Prepared {
     /// (crate::layer, "First order"). Returned as two solutions on the same
     /// grids; the slope's `medium` is the medium's slope.
     pub fn solve_first_order(&self, tau: f64) -> Result<(Solution, Solution), SlabError> {
-        let [front, back] = &self.faces;
         let solved: Vec<[Layer; 4]> = (0..self.orders)
             .into_par_iter()
             .map(|m| {
                 let (med, _) = medium_layer(&self.inside, &self.phase, m, 0.0, tau, self.start)?;
                 let med = med.into_layer();
                 let d_med = medium_slope(&self.inside, &self.phase, m, tau, self.start)?.into_layer();
-                let top = match &self.coating {
-                    Some(c) => &c.front[m],
-                    None => &front.orders[m],
-                };
+                let top = self.top(m);
                 let flat = |l: &Layer| Layer::zero_slope(l.n_top(), l.n_bot());
                 let (upper, d_upper) = top.add_with_slope(&flat(top), &med, &d_med)?;
-                let bottom = back.orders[m].flipped();
+                let bottom = self.faces[1].orders[m].flipped();
                 let (sheet, d_sheet) = upper.add_with_slope(&d_upper, &bottom, &flat(&bottom))?;
                 Ok([sheet, med, d_sheet, d_med])
             })
@@ -463,17 +467,7 @@ impl Prepared {
             }
         }
         let [orders, medium, d_orders, d_medium] = parts;
-        let solution = |orders, medium| Solution {
-            outside: self.outside.clone(),
-            inside: self.inside.clone(),
-            coating: self.coating.as_ref().map(|c| c.grid.clone()),
-            orders,
-            medium,
-            doublings: 0,
-            phase_scale: self.phase.scale.clone(),
-            face_compensation: [front.compensation.clone(), back.compensation.clone()],
-        };
-        Ok((solution(orders, medium), solution(d_orders, d_medium)))
+        Ok((self.solution(orders, medium, 0), self.solution(d_orders, d_medium, 0)))
     }
 }
 
