@@ -11,7 +11,12 @@ mod support;
 
 use support::{fails_with, run};
 
-const TRUTH: &str = r#"{"d":0.03,"sigma_a":0.5,"sigma_s":60,"g_f":0.6,"g_b":-0.3,"w_b":0.2,"eta_f":1.5,"eta_b":1.4,"m_f":0.3,"m_b":0.15,"dist_f":"ggx","dist_b":"ggx"}"#;
+// The slab crate's thin coated sheet (text only, shared by `#[path]`).
+#[path = "../../slab/tests/support/thin_coated.rs"]
+mod thin_coated;
+
+/// The sheet the data are made from.
+const TRUTH: &str = thin_coated::THIN_COATED_SHEET_JSON;
 
 /// Writes to `data` what `slab` (with `extra` arguments, e.g. `--slab-nodes
 /// 16`) gives for TRUTH at 0, 30 and 60 degrees, every 10 degrees in the plane.

@@ -19,6 +19,8 @@ use std::time::Instant;
 
 #[path = "../../sim/examples/support/cases.rs"]
 mod cases;
+#[path = "../tests/support/thin_coated.rs"]
+mod thin_coated;
 
 fn main() {
     let mut only: Vec<String> = std::env::args().skip(1).collect();
@@ -55,25 +57,14 @@ fn main() {
             ..preset("matte").expect("preset")
         },
     ));
-    // A thin coated sheet (tests/cli_refine.rs's): its unscattered term
-    // crosses the coating/base boundary (since 2026-12-07).
+    // The thin coated sheet of the tests (tests/support/thin_coated.rs):
+    // its unscattered term crosses the coating/base boundary (since
+    // 2026-12-07).
     sheets.push((
         "thin-coated".into(),
         PaperParams {
             name: Some("thin coated sheet, GGX 0.3 front of 1.5 over a base of 1.4, GGX 0.15 back".into()),
-            d: 0.03,
-            sigma_a: Colour::Scalar(0.5),
-            sigma_s: Colour::Scalar(60.0),
-            g_f: 0.6,
-            g_b: -0.3,
-            w_b: 0.2,
-            eta_f: 1.5,
-            eta_b: 1.4,
-            m_f: 0.3,
-            m_b: 0.15,
-            dist_f: Distribution::Ggx,
-            dist_b: Distribution::Ggx,
-            ..preset("matte").expect("preset")
+            ..serde_json::from_str(thin_coated::THIN_COATED_SHEET_JSON).expect("the shared sheet is valid JSON")
         },
     ));
     for (name, p) in sheets.iter().filter(|(n, _)| only.is_empty() || only.contains(n)) {

@@ -8,6 +8,7 @@
 #![allow(dead_code)]
 
 pub mod lobe_points;
+pub mod thin_coated;
 
 use nalgebra::DMatrix;
 use paperbsdf_core::{DVec3, Distribution, PaperParams};
@@ -132,14 +133,8 @@ pub fn with_both_faces(p: PaperParams, eta: f64, m: f64, dist: Distribution) -> 
     }
 }
 
-/// The coated sheet of `tests/cli_refine.rs` (a thin sheet, optical
-/// thickness 1.8, a GGX 0.3 front of index 1.5 over a base of 1.4 with a
-/// GGX 0.15 back; `face_scattering` "multiple"): fitted papers have a front
-/// and a base of different indices (docs/fit_table.md), and thin ones light
-/// through.
+/// The thin coated sheet of `thin_coated.rs` (shared with the CLI's
+/// `tests/cli_refine.rs` and `examples/slab_build.rs`).
 pub fn thin_coated_sheet() -> PaperParams {
-    serde_json::from_str(
-        r#"{"d":0.03,"sigma_a":0.5,"sigma_s":60,"g_f":0.6,"g_b":-0.3,"w_b":0.2,"eta_f":1.5,"eta_b":1.4,"m_f":0.3,"m_b":0.15,"dist_f":"ggx","dist_b":"ggx"}"#,
-    )
-    .unwrap()
+    serde_json::from_str(thin_coated::THIN_COATED_SHEET_JSON).unwrap()
 }
