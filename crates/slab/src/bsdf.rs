@@ -4464,16 +4464,23 @@ mod tests {
     fn law_exponent_measures_the_shape_change() {
         let (n, orders) = (4usize, 24usize);
         let sin = [0.9f64, 0.7, 0.55, 0.3];
+        // A grey table of order `m` at pair `p` `coef(p, m)` in all four blocks.
+        let tables_of = |coef: &dyn Fn(usize, usize) -> f64| -> Tables {
+            let tab: Vec<Rgb> = (0..n * n)
+                .flat_map(|p| (0..orders).map(move |m| Rgb::splat(coef(p, m))))
+                .collect();
+            let c = [0, 1].map(|_| [tab.clone(), tab.clone()]);
+            Tables::truncate(c, n, [[orders; 2]; 2], true, orders, false)
+        };
+        // Orders `(s_o s_j)^(kappa m) 0.6^m` (order 5 negative), times an
+        // amplitude that changes from pair to pair if `amplitude`.
         let table = |kappa: f64, amplitude: bool| -> Tables {
-            let coef = |p: usize, m: usize| -> Rgb {
+            tables_of(&|p, m| {
                 let (o, j) = (p / n, p % n);
                 let b = if m == 5 { -0.6f64.powi(5) } else { 0.6f64.powi(m as i32) };
                 let a = if amplitude { 1.0 + 0.3 * (o + 2 * j) as f64 } else { 1.0 };
-                Rgb::splat(a * (sin[o] * sin[j]).powf(kappa * m as f64) * b)
-            };
-            let tab: Vec<Rgb> = (0..n * n).flat_map(|p| (0..orders).map(move |m| coef(p, m))).collect();
-            let c = [0, 1].map(|_| [tab.clone(), tab.clone()]);
-            Tables::truncate(c, n, [[orders; 2]; 2], true, orders, false)
+                a * (sin[o] * sin[j]).powf(kappa * m as f64) * b
+            })
         };
         for (kappa, want) in [(0.0, 0.0), (0.35, 0.35), (1.0, 1.0), (1.6, 1.0), (-0.5, 0.0)] {
             let t = table(kappa, false);
@@ -4505,14 +4512,12 @@ mod tests {
         // through 0. Weighted by `max(x y, 0)` its term vanishes as `e ln e`;
         // weighted by `|x|` and skipped on a sign change it would jump.
         let share_at = |e: f64| -> f64 {
-            let coef = |p: usize, m: usize| -> Rgb {
+            tables_of(&|p, m| {
                 let (o, j) = (p / n, p % n);
                 let scale = if p == 2 * n + 2 && m == 3 { e } else { 1.0 };
-                Rgb::splat(scale * (sin[o] * sin[j]).powf(0.35 * m as f64) * 0.6f64.powi(m as i32))
-            };
-            let tab: Vec<Rgb> = (0..n * n).flat_map(|p| (0..orders).map(move |m| coef(p, m))).collect();
-            let c = [0, 1].map(|_| [tab.clone(), tab.clone()]);
-            Tables::truncate(c, n, [[orders; 2]; 2], true, orders, false).law_exponent(0, n + 1, n, &sin)
+                scale * (sin[o] * sin[j]).powf(0.35 * m as f64) * 0.6f64.powi(m as i32)
+            })
+            .law_exponent(0, n + 1, n, &sin)
         };
         let (above, below) = (share_at(1e-7), share_at(-1e-7));
         assert!(
