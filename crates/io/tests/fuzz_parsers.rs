@@ -13,32 +13,14 @@ use paperbsdf_io::dirs::parse_dirs;
 use paperbsdf_io::measurement::{parse_measurement, read_measurement};
 use paperbsdf_io::params::parse_text;
 use proptest::prelude::*;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
-struct Largest;
-static LARGEST: AtomicUsize = AtomicUsize::new(0);
-unsafe impl GlobalAlloc for Largest {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        LARGEST.fetch_max(l.size(), Ordering::Relaxed);
-        System.alloc(l)
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        System.dealloc(p, l)
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        LARGEST.fetch_max(n, Ordering::Relaxed);
-        System.realloc(p, l, n)
-    }
-}
-#[global_allocator]
-static A: Largest = Largest;
+#[path = "common/largest_alloc.rs"]
+mod largest_alloc;
 
 const ALLOC_LIMIT: usize = 16 << 20;
 
 fn bounded() {
-    let m = LARGEST.load(Ordering::Relaxed);
-    assert!(m < ALLOC_LIMIT, "an allocation of {m} bytes");
+    largest_alloc::assert_bounded(ALLOC_LIMIT);
 }
 
 /// A text that is mostly valid: fragments of the format mixed with noise.

@@ -9,31 +9,13 @@ use paperbsdf_render::spec::Resources;
 use paperbsdf_render::texture::Image;
 use paperbsdf_render::{load_scene, load_scene_str};
 use proptest::prelude::*;
-use std::alloc::{GlobalAlloc, Layout, System};
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
-struct Largest;
-static LARGEST: AtomicUsize = AtomicUsize::new(0);
-unsafe impl GlobalAlloc for Largest {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        LARGEST.fetch_max(l.size(), Ordering::Relaxed);
-        System.alloc(l)
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        System.dealloc(p, l)
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        LARGEST.fetch_max(n, Ordering::Relaxed);
-        System.realloc(p, l, n)
-    }
-}
-#[global_allocator]
-static A: Largest = Largest;
+#[path = "../../io/tests/common/largest_alloc.rs"]
+mod largest_alloc;
 
 fn bounded() {
-    let m = LARGEST.load(Ordering::Relaxed);
-    assert!(m < 64 << 20, "an allocation of {m} bytes");
+    largest_alloc::assert_bounded(64 << 20);
 }
 
 const GOOD: &str = r#"

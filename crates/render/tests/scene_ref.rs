@@ -11,6 +11,7 @@ use paperbsdf_core::Rgb;
 use paperbsdf_render::{builtin, film, RenderOptions};
 use std::sync::atomic::AtomicBool;
 
+#[path = "../../io/tests/common/mod.rs"]
 mod common;
 
 const REF_SPP: f64 = 16384.0;

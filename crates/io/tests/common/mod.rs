@@ -1,6 +1,7 @@
 //! Where the tests find the independent reference data: the repository's
 //! `data/reference` (provenance in its README), or `$PAPERBSDF_REFERENCE` if set.
-//! Used by this crate's tests and, through `#[path]`, by the CLI's.
+//! Used by this crate's tests and, through `#[path]`, by the CLI's and the
+//! renderer's.
 #![allow(dead_code)]
 
 use std::path::PathBuf;
