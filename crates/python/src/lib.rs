@@ -681,15 +681,18 @@ fn slab_nodes_range() -> (usize, usize) {
     (*r.start(), *r.end())
 }
 
-/// The nodes per hemisphere a `slab` FIT.json was solved with (its
-/// `slab_nodes`; `None` if absent or if `source` is not a FIT.json), or a
-/// `ValueError` naming the file when the value is not allowed.
+/// [`read_source`] with the nodes per hemisphere a `slab` FIT.json was
+/// solved with (its `slab_nodes`; `None` if absent or if `source` is not a
+/// FIT.json): `(text, origin, is_toml, nodes)` from one read of the file,
+/// or a `ValueError` naming the file when it cannot be read or the value is
+/// not allowed.
 #[pyfunction]
-fn recorded_slab_nodes(source: &str) -> PyResult<Option<usize>> {
+fn read_source_recorded(source: &str) -> PyResult<(String, String, bool, Option<usize>)> {
     let s = paperbsdf_io::read_source_full(source).map_err(|e| value_error(e.to_string()))?;
-    SlabSettings::recorded(s.fit_slab_nodes.as_ref(), &s.origin)
+    let nodes = SlabSettings::recorded(s.fit_slab_nodes.as_ref(), &s.origin)
         .map(|r| r.nodes)
-        .map_err(|e| value_error(e.to_string()))
+        .map_err(|e| value_error(e.to_string()))?;
+    Ok((s.text, s.origin, s.is_toml, nodes))
 }
 
 /// Whether a flags value (bits of `BsdfFlags`) has a delta lobe.
@@ -709,7 +712,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(params_json, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
-    m.add_function(wrap_pyfunction!(recorded_slab_nodes, m)?)?;
+    m.add_function(wrap_pyfunction!(read_source_recorded, m)?)?;
     m.add_function(wrap_pyfunction!(slab_nodes_range, m)?)?;
     m.add_function(wrap_pyfunction!(flags_is_specular, m)?)?;
     m.add_function(wrap_pyfunction!(read_source, m)?)?;

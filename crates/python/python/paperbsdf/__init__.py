@@ -136,12 +136,16 @@ class Bsdf:
         if not isinstance(model, str):
             raise ValueError(f"model: expected a name ({', '.join(MODEL_NAMES)}), got {type(model).__name__}")
         slab_nodes = _slab_nodes_arg(slab_nodes)
-        if slab_nodes is None and model == "slab" and isinstance(params, (str, os.PathLike)):
-            # A slab FIT.json is solved with the nodes it was fitted with.
-            path = os.fspath(params)
-            if os.path.isfile(path):
-                slab_nodes = _native.recorded_slab_nodes(path)
-        text, origin, is_toml = _params_text(params, model)
+        path = os.fspath(params) if isinstance(params, (str, os.PathLike)) else None
+        if slab_nodes is None and model == "slab" and path is not None and os.path.isfile(path):
+            # A slab FIT.json is solved with the nodes it was fitted with
+            # (the file read once for both).
+            try:
+                text, origin, is_toml, slab_nodes = _native.read_source_recorded(path)
+            except ValueError as e:
+                raise ValueError(f"params: {e}") from None
+        else:
+            text, origin, is_toml = _params_text(params, model)
         self._native = _native.Model(model, text, origin, is_toml, slab_nodes)
         self._text = text
         self.model = model
