@@ -375,7 +375,7 @@ fn paper_models_and_components() {
 /// matte sheet's in-plane values (reflection and transmission, 0 and 45
 /// degrees, -80 to 80) by more than rounding (measured 9e-4 of the value at
 /// 45 R -80) and by less than 1% (the node change of the accuracy cases,
-/// README "Convergence": matte 0.33% at most on a dense grid, 0.97% the
+/// docs/slab.md "Convergence": matte 0.33% at most on a dense grid, 0.97% the
 /// largest of all). Out of range, or with another model, it is an error
 /// naming the flag, not ignored.
 #[test]

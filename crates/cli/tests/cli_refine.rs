@@ -193,7 +193,7 @@ fn refine_with_slab_nodes_records_them() {
     }
     // `eval` of the fit: its 16 nodes, unless --slab-nodes says otherwise.
     // Lit at 60 degrees and seen at -80, 16 nodes differ from 32 by about
-    // 0.5% (README "Convergence": the grazing pairs move most).
+    // 0.5% (docs/slab.md "Convergence": the grazing pairs move most).
     let recorded = eval_at(&fit_json, "60", "-80", &[]);
     let with_16 = eval_at(&fit_json, "60", "-80", &["--slab-nodes", "16"]);
     let with_32 = eval_at(&fit_json, "60", "-80", &["--slab-nodes", "32"]);

@@ -52,7 +52,7 @@ pub struct SlabSettings {
 
 /// The node counts [`SlabSettings::nodes`] accepts. Below 2 there is no
 /// grid; above 256 a build takes minutes and its tables gigabytes (64
-/// nodes: about 4 times the default's build time and 3.5 times its memory, README
+/// nodes: about 4 times the default's build time and 3.5 times its memory, docs/slab.md
 /// "Convergence").
 pub const SLAB_NODES_RANGE: std::ops::RangeInclusive<usize> = 2..=256;
 
@@ -110,7 +110,7 @@ impl SlabSettings {
                     file: flag.to_string(),
                     message: format!(
                         "{n} is outside the allowed range [{}, {}] of nodes per hemisphere (default 32; 64 converges \
-                         the model's values to within 0.2% of twice the nodes on the accuracy cases but one, README \
+                         the model's values to within 0.2% of twice the nodes on the accuracy cases but one, docs/slab.md \
                          \"Convergence\")",
                         SLAB_NODES_RANGE.start(),
                         SLAB_NODES_RANGE.end()

@@ -98,7 +98,7 @@ fn paper_model_key() {
 /// `slab_nodes` reaches the model `slab` of a paper material: 16 nodes
 /// move the sheet's value (matte, lit at 45 degrees, seen at 80 on the
 /// mirror side) by more than rounding (measured 0.4%) and less than 2%
-/// (the node change roughly quadruples from 32/64 to 16/32 nodes; README
+/// (the node change roughly quadruples from 32/64 to 16/32 nodes; docs/slab.md
 /// "Convergence": 0.33% for matte at 32 against 64); out of range, or with
 /// `model = "paper"`, it is an error naming the material and the key.
 #[test]

@@ -6,7 +6,7 @@
 //! the node's exact direction, 480k walks). Printed: the solution's totals
 //! at the node, the model's (`SlabBsdf::eval` integrated, `albedo_from`
 //! with 512 x 512 draws), the simulator's, and `R + T` of the last two
-//! (README, "Beckmann faces at grazing incidence": until the normalisation
+//! (docs/slab.md, "Beckmann faces at grazing incidence": until the normalisation
 //! took the albedo of `eval_mode`'s face, `interface::walter_albedo`, the
 //! model's `R + T` was 2.1e-3 and 2.9e-3 short).
 //!

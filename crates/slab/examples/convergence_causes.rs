@@ -1,5 +1,5 @@
 //! Where the remaining node changes of examples/convergence.rs come from
-//! (README, "Convergence"): the same in-plane `eval` on 32, 64 and 128
+//! (docs/slab.md, "Convergence"): the same in-plane `eval` on 32, 64 and 128
 //! nodes (16, 32, 64 in the cone of total reflection) at the points that
 //! move most, and beside them the checks that tell the causes apart:
 //! - the coated sheets with a front smoother than the grid (glossy, devB)
@@ -15,7 +15,7 @@
 //!   change of the value, and of the value without the unscattered part
 //!   (component `direct`), relative to the value: what an exact unscattered
 //!   term would leave (2026-12-06: 10.6% and 1.1%, 4.7% and 0.7%);
-//! - near grazing reflection with multiple-scattering faces (README, "luster
+//! - near grazing reflection with multiple-scattering faces (docs/slab.md, "luster
 //!   and devB at 80 degrees"): devB on the mirror diagonal from 60 to 85
 //!   degrees, luster lit at 71 and matte at 62 (between nodes) seen from
 //!   -60 to -80: the whole value and the table's part (`eval` less the lit

@@ -1,5 +1,5 @@
 //! Would a better interpolation between the nodes take out the node change
-//! of grazing reflection with multiple-scattering faces (README, "luster and
+//! of grazing reflection with multiple-scattering faces (docs/slab.md, "luster and
 //! devB at 80 degrees")? The table's part of `eval` (less the analytic
 //! surface lobe) on 32 nodes, re-interpolated two ways and compared with
 //! 128 nodes:
@@ -12,7 +12,7 @@
 //!   `eval` at the nodes) combined with the same weights geometrically.
 //!
 //! No rebalance of the energy (both factors are at most 1). Neither
-//! reaches the 0.2% target (README gives the numbers of 2026-12-07): the
+//! reaches the 0.2% target (docs/slab.md gives the numbers of 2026-12-07): the
 //! walk's peak needs more nodes, not another interpolation.
 //!
 //! `cargo run --release -p paperbsdf-slab --example grazing_envelope`

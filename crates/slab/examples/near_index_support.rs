@@ -1,5 +1,5 @@
 //! Which faces close to index-matched `slab` builds and which it refuses
-//! (`SlabError::UnresolvedFace`; README, "Faces close to index-matched"):
+//! (`SlabError::UnresolvedFace`; docs/slab.md, "Faces close to index-matched"):
 //! the matte preset with both faces of index `eta` and roughness `m`, both
 //! distributions and both face modes, default discretisation; then the
 //! corners of the fit's bounds (`eta` 1.05 and 3, `m` 0.01 and `pi / 2`,

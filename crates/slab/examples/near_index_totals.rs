@@ -9,7 +9,7 @@
 //! at the outside nodes of 0, 43.5, 75.3 and 85.5 degrees (default 32
 //! nodes; the simulator gets the node's exact direction). Prints `slab -
 //! simulator` in units of the simulator's standard error and the RMS
-//! difference over all of them (README, "Faces close to index-matched";
+//! difference over all of them (docs/slab.md, "Faces close to index-matched";
 //! `crates/slab/src/interface.rs`, "Narrow transmission lobes").
 //!
 //! `cargo run --release -p paperbsdf-slab --example near_index_totals [--newton] [WALKS]`

@@ -1,5 +1,5 @@
 //! Would a quadratic interpolation on the triangles take out the node
-//! change that the linear one leaves (README, "luster and devB at 80
+//! change that the linear one leaves (docs/slab.md, "luster and devB at 80
 //! degrees" and the thin sheets' forward lobe)? In-plane values of `eval`
 //! at the 32 nodes (less the analytic surface lobe in reflection),
 //! interpolated on each triangle of node pairs (the cell split along
@@ -15,7 +15,7 @@
 //!
 //! A probe, not a model: no rebalance of the energy, no sine law within
 //! 45 degrees of the normal (so its numbers there are not `eval`'s), nine
-//! node pairs per point where `eval` sums three. README gives the numbers
+//! node pairs per point where `eval` sums three. docs/slab.md gives the numbers
 //! of 2026-12-07.
 //!
 //! `cargo run --release -p paperbsdf-slab --example quadratic_triangles [CASE...]`

@@ -15,7 +15,7 @@
 //! nodes as the table is. Printed: the largest change of the whole value,
 //! there the change of the rest (the whole less its single scattering, as
 //! a share of the whole value), and the rest's largest change anywhere.
-//! README gives the numbers of 2026-12-07.
+//! docs/slab.md gives the numbers of 2026-12-07.
 //!
 //! `cargo run --release -p paperbsdf-slab --example smooth_forward_lobe [G_F...]`
 

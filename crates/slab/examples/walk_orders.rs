@@ -2,7 +2,7 @@
 //! orders (`SlabOptions::walk_orders`): luster's and matte's in-plane
 //! reflection at the walk's forward peak and elsewhere, the build time and
 //! the memory, for walk orders 48 (the sheet's own, Fejer-summed: the model
-//! before 2026-12-05), 192, 256 (the default) and 512. What README and
+//! before 2026-12-05), 192, 256 (the default) and 512. What docs/slab.md and
 //! src/interface.rs quote of the choice of 256.
 //!
 //! `cargo run --release -p paperbsdf-slab --example walk_orders`

@@ -1251,7 +1251,7 @@ pub const WALK_MOST_FACTOR: f64 = 2.5;
 /// rule doubling `walk_orders` (which doubles every face's orders) moves
 /// Beckmann 0.04 to 0.2 fronts by at most 0.001% there (a probe,
 /// 2026-12-06, not kept; tests/walk_orders.rs asserts it on luster with
-/// smoother fronts; README "Convergence").
+/// smoother fronts; docs/slab.md "Convergence").
 pub fn walk_orders_for(walk_orders: usize, alpha: f64, max: usize) -> usize {
     if walk_orders == 0 || alpha >= WALK_REFERENCE_ALPHA || alpha <= 0.0 {
         return walk_orders.min(max);

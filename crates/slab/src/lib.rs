@@ -68,7 +68,7 @@
 //! follows `sin^m theta` ([`bsdf::SIN_LAW_BAND`]: a thin sheet's
 //! scattered transmission on the far flank of its forward lobe, `mu_o =
 //! mu_i` with the viewer on the light's side, thin tissue 1.10% -> 0.34%
-//! with twice the nodes, weak scatter 0.56% -> 0.45%, README
+//! with twice the nodes, weak scatter 0.56% -> 0.45%, docs/slab.md
 //! "Convergence"). Still missing: convergence below 0.2% with twice the
 //! nodes at the default 32 (with 64 nodes, against 128, every accuracy
 //! case is within 0.2% but devB's grazing ridge, 0.28%, at about 4 times
@@ -106,7 +106,7 @@
 //! slowest; the dense solves' triangular substitutions are blocked,
 //! `linalg`, which made up for the edges' 35 ms per face); on the slower
 //! machine of 2026-12-06 1.00 s at most, the worst case the RGB thin sheet
-//! with unequal faces and glossy (README "Speed": reciprocity halves the
+//! with unequal faces and glossy (docs/slab.md "Speed": reciprocity halves the
 //! faces' evaluations, [`interface`], [`face_walk`]). `eval` at grazing
 //! angles near the mirror direction, where node pairs keep up to 256
 //! orders (the walk's forward peak), takes 125-152 ns with AVX2 and FMA

@@ -222,7 +222,7 @@ fn index_matched_single_is_the_closed_form() {
 /// walks per angle, `sigma` the standard error, 0.1-0.5% of the value for
 /// most points, 2-4% for the smallest singles). Each within 1% + 3 sigma:
 /// the 1% is the whole table's own accuracy (32 against 64 nodes moves
-/// such sheets by up to 0.5-1%, README "Convergence"; docs/accuracy_slab.md).
+/// such sheets by up to 0.5-1%, docs/slab.md "Convergence"; docs/accuracy_slab.md).
 /// Measured: 0.48% at most where sigma is below 0.2% (thin coated, 60 T
 /// 20, `single`); the components sum to `eval` to 1e-12.
 #[test]

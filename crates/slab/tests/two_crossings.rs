@@ -476,7 +476,7 @@ fn smooth_front_returns_the_fresnel_product() {
 /// What the term was made for: a coated front smoother than the grid
 /// (devB, Beckmann 0.08 over a coating of 1.55 on a base of 1.45) changes
 /// by less than 0.2% near the normal when the nodes are doubled (it moved
-/// by 10.4% at 2.5 R 2.5 with the round trip on the grid; README,
+/// by 10.4% at 2.5 R 2.5 with the round trip on the grid; docs/slab.md,
 /// "Convergence"). In-plane reflection within 12 degrees of the normal,
 /// around the mirror direction.
 #[test]
@@ -518,7 +518,7 @@ fn largest_change_with_twice_the_nodes(
 /// in transmission within 15 degrees of the normal when the nodes are
 /// doubled (in-plane, `theta_o` on both sides of the straight-through
 /// direction). With its unscattered transmission on the grid it moved by
-/// 9.6% there (README, "Convergence"); what is left (measured 1.5% on
+/// 9.6% there (docs/slab.md, "Convergence"); what is left (measured 1.5% on
 /// examples/convergence's dense grid) is the scattered light's linear
 /// interpolation in `mu` across a lobe a few node intervals wide, which
 /// the term does not touch (1.1% without the unscattered part,
