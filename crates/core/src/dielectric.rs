@@ -96,6 +96,33 @@ impl RoughDielectric {
 
     /// `f(wi, wo)` without cosine in the given transport mode (delta lobes excluded).
     pub fn eval_mode(&self, wi: DVec3, wo: DVec3, mode: TransportMode) -> f64 {
+        self.eval_with_masking(wi, wo, mode, |mf| (mf.g1_cos(wi.z), mf.g1_cos(wo.z)))
+    }
+
+    /// [`RoughDielectric::eval_mode`] with the masking of the two
+    /// directions given: `g1_wi` and `g1_wo` must be [`Microfacet::g1_cos`]
+    /// of `wi.z` and `wo.z` (it depends on the cosine alone; whether a
+    /// direction sees the front of the micro-normal is checked here). For
+    /// a caller that evaluates the face at many azimuths of the same two
+    /// cosines (`paperbsdf_slab`'s projection of the face on its grids):
+    /// the masking is then computed once per cosine instead of twice per
+    /// evaluation. Equal to `eval_mode` to the bit (unit test
+    /// `eval_with_given_masking_is_eval_mode`).
+    #[inline]
+    pub fn eval_mode_masked(&self, wi: DVec3, wo: DVec3, mode: TransportMode, g1_wi: f64, g1_wo: f64) -> f64 {
+        self.eval_with_masking(wi, wo, mode, |_| (g1_wi, g1_wo))
+    }
+
+    /// The body of [`RoughDielectric::eval_mode`], the masking magnitudes of
+    /// `(wi, wo)` from `masking` (called only where `D > 0`).
+    #[inline(always)]
+    fn eval_with_masking(
+        &self,
+        wi: DVec3,
+        wo: DVec3,
+        mode: TransportMode,
+        masking: impl FnOnce(&Microfacet) -> (f64, f64),
+    ) -> f64 {
         let mf = match self.interface {
             Interface::Rough(mf) => mf,
             _ => return 0.0,
@@ -114,11 +141,17 @@ impl RoughDielectric {
         if d == 0.0 {
             return 0.0;
         }
-        let g = mf.g(v, l, h);
+        let (vh, lh) = (v.dot(h), l.dot(h));
+        // Smith's G: each direction must see the front of the micro-normal
+        // (`Microfacet::g1`).
+        if vh * cv <= 0.0 || lh * cl <= 0.0 {
+            return 0.0;
+        }
+        let (g_l, g_v) = masking(&mf);
+        let g = g_l * g_v;
         if g == 0.0 {
             return 0.0;
         }
-        let (vh, lh) = (v.dot(h), l.dot(h));
         let f = fresnel_dielectric(vh, self.eta);
         if is_reflect {
             f * d * g / (4.0 * (cv * cl).abs())

@@ -136,7 +136,15 @@ impl Microfacet {
         if w.dot(h) * w.z <= 0.0 {
             return 0.0;
         }
-        let c2 = w.z * w.z;
+        self.g1_cos(w.z)
+    }
+
+    /// [`Microfacet::g1`] of a direction with cosine `c` to the macro normal
+    /// that sees the front of the micro-normal: the masking depends on `c`
+    /// alone (exact for GGX, Walter's rational approximation for Beckmann).
+    #[inline]
+    pub fn g1_cos(&self, c: f64) -> f64 {
+        let c2 = c * c;
         let s2 = (1.0 - c2).max(0.0);
         if s2 == 0.0 {
             return 1.0;
@@ -145,7 +153,7 @@ impl Microfacet {
         match self.dist {
             Distribution::Ggx => 2.0 / (1.0 + (1.0 + tan2_a2).sqrt()),
             Distribution::Beckmann => {
-                let (n, q, _) = self.beckmann_g1_ratio(w.z.abs());
+                let (n, q, _) = self.beckmann_g1_ratio(c.abs());
                 n / q
             }
         }

@@ -22,7 +22,8 @@
 //! grids and Fourier orders ([`interface`]: a graded Gauss-Legendre rule in
 //! azimuth, symmetric normalisation to core's directional albedo) with, for
 //! `face_scattering = "multiple"`, the orders >= 2 of the simulator's
-//! microsurface walk solved on the same grids ([`face_walk`]);
+//! microsurface walk solved on the same grids ([`face_walk`]; its long
+//! series at grazing incidence projected by FFT, [`azimuth_fft`]);
 //! faces of unequal index, i.e. the coated sheet of docs/design.md 4.1
 //! (`eta_f != eta_b`: the rough air/coating front over a coating of zero
 //! thickness and the smooth coating/base boundary, [`slab`]), on a coating
@@ -121,6 +122,7 @@
 //! critical cosine, by `O(sqrt(eta_b - eta_f))` (8e-5 in the totals at a
 //! difference of 1e-6; tests/coated.rs).
 
+pub mod azimuth_fft;
 pub mod bsdf;
 pub mod error;
 pub mod face_walk;
