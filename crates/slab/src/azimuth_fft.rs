@@ -158,11 +158,8 @@ mod tests {
     /// roundings per term).
     #[test]
     fn fft_matches_the_direct_sums() {
-        let mut seed = 12345u64;
-        let mut rnd = move || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(12345);
         for &(orders, q, from) in &[
             (8, 3, 0),
             (48, 4, 0),
@@ -177,7 +174,7 @@ mod tests {
                 let phi = rule[k].0;
                 match r {
                     0 => (-(phi / 0.01).powi(2)).exp(),
-                    1 => rnd() - 0.5,
+                    1 => rng.gen_range(-0.5..0.5),
                     _ => 1.0 + phi.cos(),
                 }
             });
