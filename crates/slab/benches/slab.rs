@@ -4,8 +4,10 @@
 //! most Fourier orders), pdf, sample, at directions off the nodes, and the build
 //! (`SlabBsdf::new`: the faces' projection, one adding-doubling solve per
 //! distinct colour channel and one without scattering, the tables and the
-//! sampling densities) for matte (RGB absorption: three channels) and
-//! luster (two distinct faces, one channel); eval, pdf and sample also for
+//! sampling densities) for matte (RGB absorption: three channels), luster
+//! (two distinct faces, one channel), glossy (the slowest preset: a coated
+//! Beckmann 0.04 front whose walk has 640 orders) and the worst case, an
+//! RGB thin sheet with unequal faces; eval, pdf and sample also for
 //! the worst cases of the per-call work: glossy (a coated front, Beckmann
 //! 0.04, whose lobe is sampled more often) and a thin tissue sheet (the
 //! spread's, docs/accuracy.md: tau 1.2, mostly transmission).
@@ -18,6 +20,9 @@ use paperbsdf_slab::SlabBsdf;
 // The cases of docs/accuracy.md, as the accuracy example has them (thin tissue).
 #[path = "../../sim/examples/support/cases.rs"]
 mod cases;
+// The worst case of the builds (tests/support/build_sheets.rs).
+#[path = "../tests/support/build_sheets.rs"]
+mod build_sheets;
 
 fn bench(c: &mut Criterion) {
     for name in ["matte", "luster", "glossy", "thin-tissue"] {
@@ -95,8 +100,11 @@ fn bench(c: &mut Criterion) {
     }
     let mut g = c.benchmark_group("slab_build");
     g.sample_size(10);
-    for name in ["matte", "luster"] {
-        let p = presets::preset(name).unwrap();
+    let builds = ["matte", "luster", "glossy"]
+        .map(|name| (name, presets::preset(name).unwrap()))
+        .into_iter()
+        .chain([("rgb-thin-unequal", build_sheets::rgb_thin_unequal())]);
+    for (name, p) in builds {
         g.bench_function(name, |bn| bn.iter(|| SlabBsdf::new(black_box(&p)).unwrap()));
     }
     g.finish();

@@ -13,10 +13,12 @@
 
 use paperbsdf_core::bsdf::albedo_from;
 use paperbsdf_core::presets::preset;
-use paperbsdf_core::{Colour, DVec3, Distribution, PaperParams};
+use paperbsdf_core::{DVec3, PaperParams};
 use paperbsdf_slab::{SlabBsdf, SlabOptions};
 use std::time::Instant;
 
+#[path = "../tests/support/build_sheets.rs"]
+mod build_sheets;
 #[path = "../../sim/examples/support/cases.rs"]
 mod cases;
 #[path = "../tests/support/thin_coated.rs"]
@@ -43,20 +45,7 @@ fn main() {
         .map(|n| (n.to_string(), preset(n).expect("preset")))
         .collect();
     sheets.extend(cases::cases().into_iter().filter(|(n, _)| !n.starts_with("preset-")));
-    sheets.push((
-        "rgb-thin-unequal".into(),
-        PaperParams {
-            name: Some("RGB thin sheet, GGX 0.1 front, Beckmann 0.25 back".into()),
-            d: 0.03,
-            sigma_a: Colour::Rgb([0.2, 1.5, 4.0]),
-            sigma_s: Colour::Rgb([40.0, 38.0, 35.0]),
-            m_f: 0.1,
-            m_b: 0.25,
-            dist_f: Distribution::Ggx,
-            dist_b: Distribution::Beckmann,
-            ..preset("matte").expect("preset")
-        },
-    ));
+    sheets.push(("rgb-thin-unequal".into(), build_sheets::rgb_thin_unequal()));
     // The thin coated sheet of the tests (tests/support/thin_coated.rs):
     // its unscattered term crosses the coating/base boundary (since
     // 2026-12-07).

@@ -54,7 +54,8 @@
 //! `P = max(16, orders)` uniform panels ([`MIN_AZIMUTH_PANELS`]), the first
 //! of which is split geometrically toward 0 into panels
 //! `[0, d], [d, 2d], [2d, 4d], ...` with `d = (pi / P) 2^-14`
-//! ([`AZIMUTH_GRADING_LEVELS`]): `q (P + 14)` points, 240 by default.
+//! ([`AZIMUTH_GRADING_LEVELS`]): `q (P + 14)` points, 496 with the default
+//! 48 orders (240 with 16).
 //! Gauss-Legendre integrates the smooth parts to high order, and the panel
 //! edges bound the error of the kink where the refraction lobe ends; doubling
 //! `q` changes the totals of the sheets in the tests by less than 1e-6
