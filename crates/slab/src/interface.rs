@@ -781,7 +781,8 @@ fn transmission_cell_averages(
 }
 
 /// The transmission pairs `(a, b)` (inside node `a`, outside node `b`)
-/// that [`transmission_cell_averages`] replaces by the cells' averages.
+/// that the projection of the face (`transmission_cell_averages`, private)
+/// replaces by the cells' averages.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AveragedPairs {
     /// Those the refraction edge crosses, wholly averaged (GGX faces only:
