@@ -99,10 +99,23 @@ impl RoughDielectric {
         self.eval_with_masking(wi, wo, mode, |mf| (mf.g1_cos(wi.z), mf.g1_cos(wo.z)))
     }
 
+    /// The Smith masking of a direction with cosine `c` that sees the front
+    /// of the micro-normal, as [`RoughDielectric::eval_mode`] has it
+    /// ([`Microfacet::g1_cos`] of the face's microfacets; 0 for a face
+    /// without them, whose `eval_mode` is 0).
+    #[inline]
+    pub fn g1_cos(&self, c: f64) -> f64 {
+        match self.interface {
+            Interface::Rough(mf) => mf.g1_cos(c),
+            _ => 0.0,
+        }
+    }
+
     /// [`RoughDielectric::eval_mode`] with the masking of the two
-    /// directions given: `g1_wi` and `g1_wo` must be [`Microfacet::g1_cos`]
-    /// of `wi.z` and `wo.z` (it depends on the cosine alone; whether a
-    /// direction sees the front of the micro-normal is checked here). For
+    /// directions given: `g1_wi` and `g1_wo` must be
+    /// [`RoughDielectric::g1_cos`] of `wi.z` and `wo.z` (it depends on the
+    /// cosine alone; whether a direction sees the front of the micro-normal
+    /// is checked here). For
     /// a caller that evaluates the face at many azimuths of the same two
     /// cosines (`paperbsdf_slab`'s projection of the face on its grids):
     /// the masking is then computed once per cosine instead of twice per

@@ -373,7 +373,7 @@ fn integrals_continuous_at_normal_incidence() {
 }
 
 /// `eval_mode_masked` with the masking of the two cosines given
-/// (`Microfacet::g1_cos`) is `eval_mode` to the bit: reflection and
+/// (`RoughDielectric::g1_cos`, the microfacets' `g1_cos`) is `eval_mode` to the bit: reflection and
 /// transmission from either side, both transport modes, both
 /// distributions, smooth to very rough faces, down to grazing cosines, and
 /// pairs where a direction sees the back of the micro-normal (which both
@@ -388,6 +388,10 @@ fn eval_with_given_masking_is_eval_mode() {
             let paperbsdf_core::dielectric::Interface::Rough(mf) = b.interface else {
                 panic!("a rough face");
             };
+            // The face's masking is its microfacets' (the sign of the cosine aside).
+            for c in [1.0, 0.7, 0.1, 1e-3, -0.4] {
+                assert_eq!(b.g1_cos(c).to_bits(), mf.g1_cos(c).to_bits(), "{dist} m {m} cos {c}");
+            }
             for _ in 0..4000 {
                 let dir = |rng: &mut rand::rngs::StdRng| {
                     let c: f64 = rng.gen_range(-1.0..1.0);
@@ -401,7 +405,7 @@ fn eval_with_given_masking_is_eval_mode() {
                 let (wi, wo) = (dir(&mut rng), dir(&mut rng));
                 for mode in [TransportMode::Radiance, TransportMode::Importance] {
                     let want = b.eval_mode(wi, wo, mode);
-                    let got = b.eval_mode_masked(wi, wo, mode, mf.g1_cos(wi.z), mf.g1_cos(wo.z));
+                    let got = b.eval_mode_masked(wi, wo, mode, b.g1_cos(wi.z), b.g1_cos(wo.z));
                     assert_eq!(
                         got.to_bits(),
                         want.to_bits(),

@@ -1,6 +1,10 @@
 //! Fourier coefficients of samples on the azimuth rule of
-//! [`crate::interface::azimuth_rule`] by FFT, for the long series of the
-//! microsurface walk's reflection at grazing incidence (up to 640 orders,
+//! [`crate::interface::azimuth_rule`]: the one projection in azimuth of the
+//! faces' projections (Walter's blocks and cell averages in
+//! [`crate::interface`], the microsurface walk's kernel in
+//! [`crate::face_walk`]). A matrix product with the rule's weighted
+//! cosines, and by FFT for the long series of the walk's reflection at
+//! grazing incidence (up to 640 orders,
 //! [`crate::face_walk::outside_reflection`]).
 //!
 //! The rule on `[0, pi]` has `P = max(16, L)` panels of width `w = pi / P`
@@ -35,8 +39,11 @@ use std::sync::Arc;
 pub const FFT_MIN_ORDERS: usize = 128;
 
 /// The Fourier projection of samples at the points of
-/// `azimuth_rule(orders, q)` onto the orders `from..orders`.
+/// `azimuth_rule(orders, q)` onto the orders `from..orders`, with the
+/// rule's points (where the samples are taken).
 pub struct RuleProjection {
+    /// `(cos phi_k, sin phi_k)` of the rule's points.
+    phis: Vec<(f64, f64)>,
     from: usize,
     orders: usize,
     q: usize,
@@ -74,20 +81,24 @@ impl RuleProjection {
         });
         let width = PI / panels as f64;
         let (x, w) = gauss_legendre_01(q);
-        let phases = x
-            .iter()
-            .zip(&w)
-            .map(|(&xi, &wi)| {
-                let ph = (from..orders)
-                    .map(|m| {
-                        let a = m as f64 * width * xi;
-                        (a.cos(), a.sin())
-                    })
-                    .collect();
-                (2.0 * width * wi, ph)
-            })
-            .collect();
+        let phases = if fft {
+            x.iter()
+                .zip(&w)
+                .map(|(&xi, &wi)| {
+                    let ph = (from..orders)
+                        .map(|m| {
+                            let a = m as f64 * width * xi;
+                            (a.cos(), a.sin())
+                        })
+                        .collect();
+                    (2.0 * width * wi, ph)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         RuleProjection {
+            phis: rule.iter().map(|&(phi, _)| (phi.cos(), phi.sin())).collect(),
             from,
             orders,
             q,
@@ -97,6 +108,17 @@ impl RuleProjection {
             phases,
             fft: fft.then(|| FftPlanner::new().plan_fft_inverse(2 * panels)),
         }
+    }
+
+    /// `(cos phi_k, sin phi_k)` of the rule's points, in its order.
+    pub fn phis(&self) -> &[(f64, f64)] {
+        &self.phis
+    }
+
+    /// The coefficients per row of [`RuleProjection::project`]'s result:
+    /// `orders - from`.
+    pub fn coefficients(&self) -> usize {
+        self.orders - self.from
     }
 
     /// The coefficients of each row of `vals` (samples at the rule's

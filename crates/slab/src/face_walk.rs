@@ -77,7 +77,7 @@
 
 use crate::azimuth_fft::RuleProjection;
 use crate::error::SlabError;
-use crate::interface::{azimuth_rule, cells, newton_scaling, scale_rows_cols, NORMALISATION_SLOW_TOLERANCE};
+use crate::interface::{cells, newton_scaling, scale_rows_cols, NORMALISATION_SLOW_TOLERANCE};
 use crate::layer::Layer;
 use crate::quad::Grid;
 use nalgebra::DMatrix;
@@ -254,15 +254,13 @@ fn phase_matrices(s: &Microsurface, st: &[State], orders: usize, q: usize) -> Ve
 
 /// `P_m` for the orders `from..orders` (the azimuth rule of `orders`).
 fn phase_matrices_from(s: &Microsurface, st: &[State], from: usize, orders: usize, q: usize) -> Vec<DMatrix<f64>> {
-    let rule = azimuth_rule(orders, q);
     // A row's Fourier coefficients: one matrix product with the rule's
     // weighted cosines (blocked and vectorised by nalgebra), the uniform
     // panels by FFT for long series (the outside chain's up to 640 orders:
     // its product took 0.16 s of glossy's build on one thread).
     let projection = RuleProjection::new(orders, q, from);
-    let phis: Vec<(f64, f64)> = rule.iter().map(|&(phi, _)| (phi.cos(), phi.sin())).collect();
     let n = st.len();
-    let cols = kernel_coefficients(s, st, &phis, &projection, true);
+    let cols = kernel_coefficients(s, st, &projection, true);
     (0..orders - from)
         .map(|m| DMatrix::from_fn(n, n, |b, a| cols[a][(b, m)]))
         .collect()
@@ -270,7 +268,7 @@ fn phase_matrices_from(s: &Microsurface, st: &[State], from: usize, orders: usiz
 
 /// The Fourier coefficients of the chain's kernel from every state `a`
 /// (one matrix each: rows the states `b`, columns the orders of
-/// `projection`, from samples at the azimuths `phis` of its rule), the
+/// `projection`, from samples at the azimuths of its rule), the
 /// cells across an edge averaged (GGX). With `reciprocal`, only one of each
 /// pair of reverse paths is evaluated: light from `a` to `b` and light
 /// from `b` reversed (`rev b`: the same node, the other way up) to `a`
@@ -289,10 +287,10 @@ fn phase_matrices_from(s: &Microsurface, st: &[State], from: usize, orders: usiz
 fn kernel_coefficients(
     s: &Microsurface,
     st: &[State],
-    phis: &[(f64, f64)],
     projection: &RuleProjection,
     reciprocal: bool,
 ) -> Vec<DMatrix<f64>> {
+    let phis = projection.phis();
     let n = st.len();
     let n_phi = phis.len();
     let scatterers: Vec<Scatterer> = st.iter().map(|a| s.scatter_from(-a.dir(1.0, 0.0), a.outside)).collect();
@@ -769,10 +767,6 @@ mod tests {
     fn reverse_paths_are_reciprocal() {
         let outside = Grid::outside(10);
         let (orders, q) = (16, 2);
-        let phis: Vec<(f64, f64)> = azimuth_rule(orders, q)
-            .iter()
-            .map(|&(p, _)| (p.cos(), p.sin()))
-            .collect();
         for (dist, m, eta) in [
             (Distribution::Ggx, 0.3, 1.5),
             (Distribution::Beckmann, 0.1, 1.5),
@@ -785,8 +779,8 @@ mod tests {
             let outside_only: Vec<State> = all.iter().filter(|a| a.outside).copied().collect();
             for (st, fft) in [(&all, false), (&outside_only, true)] {
                 let projection = RuleProjection::with_fft(orders, q, 0, fft);
-                let fast = kernel_coefficients(&s, st, &phis, &projection, true);
-                let slow = kernel_coefficients(&s, st, &phis, &projection, false);
+                let fast = kernel_coefficients(&s, st, &projection, true);
+                let slow = kernel_coefficients(&s, st, &projection, false);
                 let mut worst: f64 = 0.0;
                 let mut compared = 0;
                 // Rows far below the chain's scale (a narrow lobe's tail,

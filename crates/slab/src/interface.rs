@@ -206,6 +206,7 @@
 //! walk misses some nodes altogether and cannot be scaled, gets the
 //! separable lobes instead (`compensate`; it loses almost nothing).
 
+use crate::azimuth_fft::RuleProjection;
 use crate::error::SlabError;
 use crate::layer::Layer;
 use crate::quad::Grid;
@@ -581,10 +582,10 @@ pub fn face_interface(
 /// [`transmission_cell_averages`] has it (a third of the evaluations; the unit
 /// test `light_from_inside_is_reciprocal` evaluates it directly).
 fn walter_projection(bd: &RoughDielectric, outside: &Grid, inside: &Grid, orders: usize, n_phi: usize) -> Vec<Layer> {
-    let rule = WalterRule::new(orders, n_phi);
-    let r_top = rule.block(bd, outside, true, outside, true);
-    let mut t_down = rule.block(bd, outside, true, inside, false);
-    let r_bot = rule.block(bd, inside, false, inside, false);
+    let rule = RuleProjection::new(orders, n_phi, 0);
+    let r_top = walter_block(&rule, bd, outside, true, outside, true);
+    let mut t_down = walter_block(&rule, bd, outside, true, inside, false);
+    let r_bot = walter_block(&rule, bd, inside, false, inside, false);
     let e2 = bd.eta * bd.eta;
     let mut t_up: Vec<DMatrix<f64>> = t_down
         .iter()
@@ -594,7 +595,7 @@ fn walter_projection(bd: &RoughDielectric, outside: &Grid, inside: &Grid, orders
             })
         })
         .collect();
-    transmission_cell_averages(bd, outside, inside, &rule.phis, &rule.cos_w, &mut t_down, &mut t_up);
+    transmission_cell_averages(bd, outside, inside, &rule, &mut t_down, &mut t_up);
     r_top
         .into_iter()
         .zip(t_down)
@@ -608,85 +609,64 @@ fn walter_projection(bd: &RoughDielectric, outside: &Grid, inside: &Grid, orders
         .collect()
 }
 
-/// The azimuth rule of Walter's projection ([`azimuth_rule`]) with its
-/// cosines and weights per order.
-struct WalterRule {
-    /// `(cos phi_k, sin phi_k)` of the rule's points.
-    phis: Vec<(f64, f64)>,
-    /// `cos(m phi_k)` times the rule's weight, points x orders: the Fourier
-    /// sums of a row are one matrix product (blocked and vectorised by
-    /// nalgebra).
-    cos_w: DMatrix<f64>,
-    /// Fourier orders `0..orders`.
-    orders: usize,
-}
-
-impl WalterRule {
-    fn new(orders: usize, n_phi: usize) -> WalterRule {
-        let rule = azimuth_rule(orders, n_phi);
-        WalterRule {
-            phis: rule.iter().map(|&(phi, _)| (phi.cos(), phi.sin())).collect(),
-            cos_w: DMatrix::from_fn(rule.len(), orders, |k, m| rule[k].1 * (m as f64 * rule[k].0).cos()),
-            orders,
-        }
-    }
-
-    /// One block of Walter's face per order: from the nodes of `from`
-    /// (above the face if `from_top`) to those of `to` (going up if
-    /// `to_up`), `w_j mu_j` times the face's BSDF's Fourier coefficients.
-    ///
-    /// A reflection block (`from` and `to` the same grid on the same side) is
-    /// reciprocal: `f(wi_j, wo_o(phi)) = f(wi_o, wo_j(phi))` (Walter's
-    /// reflection is symmetric in its two directions, and the face isotropic),
-    /// so only `j >= o` is evaluated and the rest mirrored (half the cost).
-    fn block(&self, bd: &RoughDielectric, from: &Grid, from_top: bool, to: &Grid, to_up: bool) -> Vec<DMatrix<f64>> {
-        let (nf, nt) = (from.len(), to.len());
-        let mirror = from_top == to_up;
-        // The masking of each node's direction, the same at every azimuth
-        // (`RoughDielectric::eval_mode_masked`): computed again at each of
-        // them it took about 10% of glossy's build on one thread (1.73 s
-        // against 1.55 s, examples/slab_build with RAYON_NUM_THREADS=1).
-        let g1 = |g: &Grid| -> Vec<f64> {
-            match bd.interface {
-                Interface::Rough(mf) => g.mu.iter().map(|&mu| mf.g1_cos(mu)).collect(),
-                _ => vec![0.0; g.len()],
-            }
-        };
-        let (g1_from, g1_to) = (g1(from), g1(to));
-        let rows: Vec<DMatrix<f64>> = (0..nt)
-            .into_par_iter()
-            .map(|o| {
-                let mu_o = to.mu[o];
-                let s_o = (1.0 - mu_o * mu_o).max(0.0).sqrt();
-                let z_o = if to_up { mu_o } else { -mu_o };
-                let vals = DMatrix::from_fn(nf, self.phis.len(), |j, k| {
-                    if mirror && j < o {
-                        return 0.0;
-                    }
-                    let mu_j = from.mu[j];
-                    let s_j = (1.0 - mu_j * mu_j).max(0.0).sqrt();
-                    // toward the light: minus the propagation direction (s_j, 0, -+mu_j)
-                    let wi = DVec3::new(-s_j, 0.0, if from_top { mu_j } else { -mu_j });
-                    let (c, s) = self.phis[k];
-                    let wo = DVec3::new(s_o * c, s_o * s, z_o);
-                    bd.eval_mode_masked(wi, wo, TransportMode::Radiance, g1_from[j], g1_to[o])
-                });
-                vals * &self.cos_w
+/// One block of Walter's face per order on the azimuth rule `rule` (its
+/// orders from 0; module doc's rule): from the nodes of `from` (above the
+/// face if `from_top`) to those of `to` (going up if `to_up`), `w_j mu_j`
+/// times the face's BSDF's Fourier coefficients.
+///
+/// A reflection block (`from` and `to` the same grid on the same side) is
+/// reciprocal: `f(wi_j, wo_o(phi)) = f(wi_o, wo_j(phi))` (Walter's
+/// reflection is symmetric in its two directions, and the face isotropic),
+/// so only `j >= o` is evaluated and the rest mirrored (half the cost).
+fn walter_block(
+    rule: &RuleProjection,
+    bd: &RoughDielectric,
+    from: &Grid,
+    from_top: bool,
+    to: &Grid,
+    to_up: bool,
+) -> Vec<DMatrix<f64>> {
+    let (nf, nt) = (from.len(), to.len());
+    let mirror = from_top == to_up;
+    // The masking of each node's direction, the same at every azimuth
+    // (`RoughDielectric::eval_mode_masked`): computed again at each of
+    // them it took about 10% of glossy's build on one thread (1.73 s
+    // against 1.55 s, examples/slab_build with RAYON_NUM_THREADS=1).
+    let g1 = |g: &Grid| -> Vec<f64> { g.mu.iter().map(|&mu| bd.g1_cos(mu)).collect() };
+    let (g1_from, g1_to) = (g1(from), g1(to));
+    let rows: Vec<DMatrix<f64>> = (0..nt)
+        .into_par_iter()
+        .map(|o| {
+            let mu_o = to.mu[o];
+            let s_o = (1.0 - mu_o * mu_o).max(0.0).sqrt();
+            let z_o = if to_up { mu_o } else { -mu_o };
+            let vals = DMatrix::from_fn(nf, rule.phis().len(), |j, k| {
+                if mirror && j < o {
+                    return 0.0;
+                }
+                let mu_j = from.mu[j];
+                let s_j = (1.0 - mu_j * mu_j).max(0.0).sqrt();
+                // toward the light: minus the propagation direction (s_j, 0, -+mu_j)
+                let wi = DVec3::new(-s_j, 0.0, if from_top { mu_j } else { -mu_j });
+                let (c, s) = rule.phis()[k];
+                let wo = DVec3::new(s_o * c, s_o * s, z_o);
+                bd.eval_mode_masked(wi, wo, TransportMode::Radiance, g1_from[j], g1_to[o])
+            });
+            rule.project(&vals)
+        })
+        .collect();
+    (0..rule.coefficients())
+        .map(|m| {
+            DMatrix::from_fn(nt, nf, |o, j| {
+                let f = if mirror && j < o {
+                    rows[j][(o, m)]
+                } else {
+                    rows[o][(j, m)]
+                };
+                from.w[j] * from.mu[j] * f
             })
-            .collect();
-        (0..self.orders)
-            .map(|m| {
-                DMatrix::from_fn(nt, nf, |o, j| {
-                    let f = if mirror && j < o {
-                        rows[j][(o, m)]
-                    } else {
-                        rows[o][(j, m)]
-                    };
-                    from.w[j] * from.mu[j] * f
-                })
-            })
-            .collect()
-    }
+        })
+        .collect()
 }
 
 /// Gauss-Legendre points per axis of the cell integrals across the
@@ -767,14 +747,13 @@ fn transmission_cell_averages(
     bd: &RoughDielectric,
     outside: &Grid,
     inside: &Grid,
-    phis: &[(f64, f64)],
-    cos_w: &DMatrix<f64>,
+    rule: &RuleProjection,
     t_down: &mut [DMatrix<f64>],
     t_up: &mut [DMatrix<f64>],
 ) {
     let AveragedPairs { edge, image, share } = averaged_pairs(bd, outside, inside);
     let mut average = |pairs: &[(usize, usize)], share: f64, points: usize| {
-        cell_averages(bd, outside, inside, phis, cos_w, (pairs, share), points, t_down, t_up)
+        cell_averages(bd, outside, inside, rule, (pairs, share), points, t_down, t_up)
     };
     average(&image, share, SNELL_IMAGE_POINTS);
     average(&edge, 1.0, EDGE_POINTS);
@@ -871,8 +850,7 @@ fn cell_averages(
     bd: &RoughDielectric,
     outside: &Grid,
     inside: &Grid,
-    phis: &[(f64, f64)],
-    cos_w: &DMatrix<f64>,
+    rule: &RuleProjection,
     (crossed, share): (&[(usize, usize)], f64),
     points: usize,
     t_down: &mut [DMatrix<f64>],
@@ -882,12 +860,7 @@ fn cell_averages(
     let (c_in, c_out) = (cells(inside, inside.len()), cells(outside, outside.len()));
     let (x, wx) = gauss_legendre_01(points);
     let sin = |mu: f64| (1.0 - mu * mu).max(0.0).sqrt();
-    // The masking of a direction, the same at every azimuth
-    // (`RoughDielectric::eval_mode_masked`, as in `WalterRule::block`).
-    let g1 = |mu: f64| match bd.interface {
-        Interface::Rough(mf) => mf.g1_cos(mu),
-        _ => 0.0,
-    };
+    let phis = rule.phis();
     let averages: Vec<(usize, usize, DMatrix<f64>)> = crossed
         .par_iter()
         .map(|&(a, b)| {
@@ -903,12 +876,14 @@ fn cell_averages(
                 let s_out = sin(mu_out);
                 // toward the light: minus the propagation direction (as in the blocks)
                 let wi = DVec3::new(-s_out, 0.0, mu_out);
-                let g1_out = g1(mu_out);
+                // The masking of a direction, the same at every azimuth
+                // (`RoughDielectric::eval_mode_masked`, as in `walter_block`).
+                let g1_out = bd.g1_cos(mu_out);
                 for (yr, wr) in x.iter().zip(&wx) {
                     let mu_in = lo + (hi_a - lo) * yr;
                     let weight = (hi_b - lo_b) * wp * (hi_a - lo) * wr * mu_out * mu_in;
                     let s_in = sin(mu_in);
-                    let g1_in = g1(mu_in);
+                    let g1_in = bd.g1_cos(mu_in);
                     for (k, &(c, s)) in phis.iter().enumerate() {
                         let wo = DVec3::new(s_in * c, s_in * s, -mu_in);
                         down[(0, k)] += weight * bd.eval_mode_masked(wi, wo, TransportMode::Radiance, g1_out, g1_in);
@@ -916,7 +891,7 @@ fn cell_averages(
                 }
             }
             let norm = inside.w[a] * inside.mu[a] * outside.w[b] * outside.mu[b];
-            (a, b, down * cos_w / norm)
+            (a, b, rule.project(&down) / norm)
         })
         .collect();
     // Reciprocity (`W_in T_down = (W_out T_up)^T`, `W = w mu / eta^2`): the
@@ -1493,7 +1468,7 @@ mod tests {
             let bd = RoughDielectric::new(dist, eta, m).expect("a valid face");
             let orders = 12;
             let layers = walter_projection(&bd, top, below, orders, 4);
-            let direct = WalterRule::new(orders, 4).block(&bd, below, false, top, true);
+            let direct = walter_block(&RuleProjection::new(orders, 4, 0), &bd, below, false, top, true);
             // Pairs held as cell averages (the refraction edge's and the
             // Snell image's), which `cell_averages` makes reciprocal itself.
             let pairs = averaged_pairs(&bd, top, below);
